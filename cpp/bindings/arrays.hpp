@@ -1,0 +1,41 @@
+// Conversion and validation of NumPy inputs for the binding: every check names the argument,
+// says what was expected and what was given (SPEC section 2), and nothing reaches the core
+// unless it is finite and shaped right.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dynid::binding {
+
+namespace py = pybind11;
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::string shape_string(const py::array& a);
+
+// Any array-like of real numbers as a C-contiguous float64 array; ValueError otherwise.
+Array as_real_array(py::handle obj, const char* name);
+
+// Raises ValueError when the array holds NaN or inf.
+void require_finite(const Array& a, const char* name);
+
+// One or several per-sample arguments (q, qd, ...): each (n,) for one sample or (T, n) for T.
+struct Samples {
+  std::vector<Array> arrays;
+  py::ssize_t count = 1;  // T
+  bool single = true;
+  const double* row(std::size_t k, py::ssize_t t, int n) const {
+    return arrays[k].data() + t * n;
+  }
+};
+
+Samples parse_samples(const std::vector<std::pair<py::handle, const char*>>& args, int n);
+
+// A fixed-size array argument (e.g. gravity (3,), base (4, 4)).
+Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_t>& shape);
+
+}  // namespace dynid::binding

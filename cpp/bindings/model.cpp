@@ -1,0 +1,368 @@
+// Binding of the Model: construction from a DH table, parameters and drive terms, and the
+// per-sample dynamics calls (single sample or a batch looped in C++).
+#include "model.hpp"
+
+#include <cctype>
+#include <stdexcept>
+
+namespace dynid::binding {
+namespace {
+
+Convention parse_convention(const std::string& convention) {
+  if (convention == "standard") return Convention::Standard;
+  if (convention == "modified") return Convention::Modified;
+  throw py::value_error("convention: expected 'standard' or 'modified', got '" + convention + "'");
+}
+
+std::vector<DHRow> parse_dh(py::handle dh_obj, const std::string& joint_types) {
+  Array dh = as_real_array(dh_obj, "dh");
+  if (dh.ndim() != 2 || dh.shape(1) != 4 || dh.shape(0) < 1)
+    throw py::value_error("dh: expected shape (n, 4) with rows [a, alpha, d, theta], n >= 1, got " +
+                          shape_string(dh));
+  require_finite(dh, "dh");
+  const auto n = static_cast<std::size_t>(dh.shape(0));
+  if (joint_types.size() != n)
+    throw py::value_error("joint_types: expected " + std::to_string(n) + " letters (one per DH row), got '" +
+                          joint_types + "'");
+  std::vector<DHRow> rows(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const char type = static_cast<char>(std::toupper(static_cast<unsigned char>(joint_types[i])));
+    if (type != 'R' && type != 'P')
+      throw py::value_error("joint_types: expected 'R' or 'P', got '" + std::string(1, joint_types[i]) +
+                            "' at position " + std::to_string(i));
+    const double* r = dh.data() + 4 * i;
+    rows[i] = DHRow{r[0], r[1], r[2], r[3], type == 'R' ? JointType::Revolute : JointType::Prismatic};
+  }
+  return rows;
+}
+
+Matrix4 parse_transform(py::handle obj, const char* name) {
+  if (obj.is_none()) return Matrix4::Identity();
+  Array a = parse_fixed(obj, name, {4, 4});
+  return Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(a.data());
+}
+
+Vector3 parse_vector3(py::handle obj, const char* name) {
+  Array a = parse_fixed(obj, name, {3});
+  return Vector3(a.data()[0], a.data()[1], a.data()[2]);
+}
+
+// A read-only copy, so that `robot.Ia[0] = 1` fails loudly instead of changing a copy.
+py::array read_only(const double* data, std::vector<py::ssize_t> shape) {
+  py::array_t<double> out(shape);
+  std::copy(data, data + out.size(), out.mutable_data());
+  py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return out;
+}
+
+py::array vector_property(const VectorX& v) { return read_only(v.data(), {v.size()}); }
+
+VectorX parse_drive(py::handle obj, const char* name, int n) {
+  Array a = parse_fixed(obj, name, {n});
+  return ConstVec(a.data(), n);
+}
+
+py::object energy(PyModel& self, const Samples& s, py::array result) {
+  if (s.single) return py::float_(*static_cast<const double*>(result.data()));
+  return result;
+}
+
+}  // namespace
+
+void bind_model(py::module_& m) {
+  py::class_<PyModel>(m, "Model")
+      .def(py::init([](py::handle dh, const std::string& joint_types, const std::string& convention,
+                       py::handle gravity, py::handle base, py::handle tool) {
+             std::vector<DHRow> rows = parse_dh(dh, joint_types);
+             return PyModel(Model(std::move(rows), parse_convention(convention),
+                                  parse_vector3(gravity, "gravity"), parse_transform(base, "base"),
+                                  parse_transform(tool, "tool")));
+           }),
+           py::arg("dh"), py::arg("joint_types"), py::arg("convention") = "standard",
+           py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("base") = py::none(),
+           py::arg("tool") = py::none())
+      .def_property_readonly("n", [](const PyModel& self) { return self.model->n(); },
+                             "Degrees of freedom.")
+      .def_property_readonly(
+          "dh",
+          [](const PyModel& self) {
+            std::vector<double> rows;
+            for (const DHRow& r : self.model->dh()) rows.insert(rows.end(), {r.a, r.alpha, r.d, r.theta});
+            return read_only(rows.data(), {self.model->n(), 4});
+          },
+          "DH table (n, 4), rows [a, alpha, d, theta] as given.")
+      .def_property_readonly(
+          "joint_types",
+          [](const PyModel& self) {
+            std::string types;
+            for (const DHRow& r : self.model->dh()) types += r.type == JointType::Revolute ? 'R' : 'P';
+            return types;
+          })
+      .def_property_readonly("convention",
+                             [](const PyModel& self) {
+                               return self.model->convention() == Convention::Standard ? "standard"
+                                                                                        : "modified";
+                             })
+      .def_property(
+          "gravity_vector", [](const PyModel& self) { return vector_property(self.model->gravity()); },
+          [](PyModel& self, py::handle g) {
+            const Vector3 v = parse_vector3(g, "gravity");
+            self.modify([&](Model& model) { model.set_gravity(v); });
+          },
+          "Gravity acceleration in world coordinates (3,).")
+      .def_property(
+          "base",
+          [](const PyModel& self) {
+            const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = self.model->base();
+            return read_only(T.data(), {4, 4});
+          },
+          [](PyModel& self, py::handle T) {
+            const Matrix4 base = parse_transform(T, "base");
+            self.modify([&](Model& model) { model.set_base(base); });
+          },
+          "World pose of frame 0 (4, 4).")
+      .def_property(
+          "tool",
+          [](const PyModel& self) {
+            const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = self.model->tool();
+            return read_only(T.data(), {4, 4});
+          },
+          [](PyModel& self, py::handle T) {
+            const Matrix4 tool = parse_transform(T, "tool");
+            self.modify([&](Model& model) { model.set_tool(tool); });
+          },
+          "Pose of the tool in the last DH frame (4, 4).")
+      .def_property(
+          "params",
+          [](const PyModel& self) {
+            const Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor> P = self.model->parameters();
+            return read_only(P.data(), {self.model->n(), 10});
+          },
+          [](PyModel& self, py::handle value) {
+            const int n = self.model->n();
+            Array a = as_real_array(value, "params");
+            const bool ok = (a.ndim() == 2 && a.shape(0) == n && a.shape(1) == 10) ||
+                            (a.ndim() == 1 && a.shape(0) == 10 * n);
+            if (!ok)
+              throw py::value_error("params: expected shape (" + std::to_string(n) + ", 10) or (" +
+                                    std::to_string(10 * n) + ",), got " + shape_string(a));
+            require_finite(a, "params");
+            const MatrixX P = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor>>(a.data(), n, 10);
+            self.modify([&](Model& model) { model.set_parameters(P); });
+          },
+          "Standard inertial parameters (n, 10): [m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] per "
+          "link, about the origin of DH frame i. Accepts (n, 10) or (10n,).")
+      .def_property(
+          "Ia", [](const PyModel& self) { return vector_property(self.model->rotor_inertia()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX Ia = parse_drive(v, "Ia", self.model->n());
+            self.modify([&](Model& model) { model.set_rotor_inertia(Ia); });
+          },
+          "Rotor inertias reflected to the link side (n,).")
+      .def_property(
+          "Fv", [](const PyModel& self) { return vector_property(self.model->viscous_friction()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX Fv = parse_drive(v, "Fv", self.model->n());
+            self.modify([&](Model& model) { model.set_viscous_friction(Fv); });
+          },
+          "Viscous friction coefficients (n,).")
+      .def_property(
+          "Fs", [](const PyModel& self) { return vector_property(self.model->coulomb_friction()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX Fs = parse_drive(v, "Fs", self.model->n());
+            self.modify([&](Model& model) { model.set_coulomb_friction(Fs); });
+          },
+          "Coulomb friction coefficients (n,).")
+      .def(
+          "_set_link_physical",
+          [](PyModel& self, int i, double mass, py::handle com, py::handle inertia_com) {
+            if (i < 0 || i >= self.model->n())
+              throw py::value_error("i: expected a link index in [0, " + std::to_string(self.model->n()) +
+                                    "), got " + std::to_string(i));
+            if (!std::isfinite(mass)) throw py::value_error("mass: expected a finite number");
+            const Vector3 c = parse_vector3(com, "com");
+            Array I = parse_fixed(inertia_com, "inertia_com", {3, 3});
+            const Matrix3 Ic = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(I.data());
+            const std::string why = physical_inconsistency(mass, Ic);
+            if (!why.empty())
+              throw py::value_error(std::string(why.rfind("mass", 0) == 0 ? "mass" : "inertia_com") +
+                                    ": link " + std::to_string(i) + " is not physically possible: " + why);
+            const RigidBodyParameters body = RigidBodyParameters::from_physical(mass, c, Ic);
+            self.modify([&](Model& model) { model.set_link(i, body); });
+          },
+          py::arg("i"), py::arg("mass"), py::arg("com"), py::arg("inertia_com"))
+      .def(
+          "_link_inconsistency",
+          [](const PyModel& self, int i) {
+            const RigidBodyParameters b = RigidBodyParameters::from_standard(
+                Eigen::Matrix<double, 1, 10>(self.model->parameters().row(i)).data());
+            if (!(b.m > 0.0)) return physical_inconsistency(b.m, Matrix3::Identity());
+            return physical_inconsistency(b.m, b.inertia_about_com());
+          },
+          "Why link i (0-based) is not physically consistent, or '' when it is.")
+      .def(
+          "rnea",
+          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
+            return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutVec tau(out, n);
+              rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
+            });
+          },
+          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).")
+      .def(
+          "mass_matrix",
+          [](PyModel& self, py::handle q) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat M = row_major(out, n, n);
+              crba(m, ws, ConstVec(in[0], n), M);
+            });
+          },
+          py::arg("q"), "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).")
+      .def(
+          "gravity",
+          [](PyModel& self, py::handle q) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutVec g(out, n);
+              gravity(m, ws, ConstVec(in[0], n), g);
+            });
+          },
+          py::arg("q"), "Gravity torques g(q).")
+      .def(
+          "coriolis",
+          [](PyModel& self, py::handle q, py::handle qd) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
+            return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutVec c(out, n);
+              coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
+            });
+          },
+          py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques c(q, qd).")
+      .def(
+          "coriolis_matrix",
+          [](PyModel& self, py::handle q, py::handle qd) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
+            return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat S = row_major(out, n, n);
+              coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
+            });
+          },
+          py::arg("q"), py::arg("qd"),
+          "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S skew-symmetric.")
+      .def(
+          "friction",
+          [](PyModel& self, py::handle qd) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{qd, "qd"}}, n);
+            return evaluate(self, s, {n}, [n](const Model& m, Workspace&, const double* const* in, double* out) {
+              OutVec tau(out, n);
+              friction(m, ConstVec(in[0], n), tau);
+            });
+          },
+          py::arg("qd"), "Joint friction Fv qd + Fs sign(qd).")
+      .def(
+          "forward_dynamics",
+          [](PyModel& self, py::handle q, py::handle qd, py::handle tau) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {tau, "tau"}}, n);
+            try {
+              return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                OutVec qdd(out, n);
+                forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), qdd);
+              });
+            } catch (const std::domain_error& e) {
+              throw py::value_error(std::string("params: ") + e.what());
+            }
+          },
+          py::arg("q"), py::arg("qd"), py::arg("tau"), "Joint accelerations for the torques tau.")
+      .def(
+          "kinetic_energy",
+          [](PyModel& self, py::handle q, py::handle qd) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
+            return energy(self, s, evaluate(self, s, {}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              *out = kinetic_energy(m, ws, ConstVec(in[0], n), ConstVec(in[1], n));
+            }));
+          },
+          py::arg("q"), py::arg("qd"), "Kinetic energy 1/2 qd^T M(q) qd (rotors included).")
+      .def(
+          "potential_energy",
+          [](PyModel& self, py::handle q) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return energy(self, s, evaluate(self, s, {}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              *out = potential_energy(m, ws, ConstVec(in[0], n));
+            }));
+          },
+          py::arg("q"), "Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).")
+      .def(
+          "fkine",
+          [](PyModel& self, py::handle q) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return evaluate(self, s, {4, 4}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat T = row_major(out, 4, 4);
+              fkine(m, ws, ConstVec(in[0], n), T);
+            });
+          },
+          py::arg("q"), "World pose (4, 4) of the tool: base A_1 ... A_n tool.")
+      .def(
+          "jacobian",
+          [](PyModel& self, py::handle q) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return evaluate(self, s, {6, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat J = row_major(out, 6, n);
+              jacobian(m, ws, ConstVec(in[0], n), J);
+            });
+          },
+          py::arg("q"), "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
+      .def(
+          "regressor",
+          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, bool rotor, bool friction) {
+            const int n = self.model->n();
+            const int P = regressor_columns(n, rotor, friction);
+            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
+            return evaluate(self, s, {n, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat Y = row_major(out, n, P);
+              regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor, friction, Y);
+            });
+          },
+          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false, py::arg("friction") = false,
+          "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea.")
+      .def(
+          "gravity_regressor",
+          [](PyModel& self, py::handle q) {
+            const int n = self.model->n();
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return evaluate(self, s, {n, 10 * n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat Y = row_major(out, n, 10 * n);
+              gravity_regressor(m, ws, ConstVec(in[0], n), Y);
+            });
+          },
+          py::arg("q"), "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
+      .def(
+          "inertia_regressor",
+          [](PyModel& self, py::handle q, bool rotor) {
+            const int n = self.model->n();
+            const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
+            const Samples s = parse_samples({{q, "q"}}, n);
+            return evaluate(self, s, {rows, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              OutMat Y = row_major(out, rows, P);
+              inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
+            });
+          },
+          py::arg("q"), py::arg("rotor") = false,
+          "Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] "
+          "(links only, or with the rotor columns the full M) (paper eq. (18)).");
+}
+
+}  // namespace dynid::binding

@@ -1,0 +1,95 @@
+// The immutable description of a serial arm: its DH table, gravity, base and tool transforms,
+// standard inertial parameters (SPEC section 2) and drive terms. Algorithms read it through a
+// const reference; every per-call buffer lives in a Workspace, so one Model serves many threads.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dynid/rigid_body.hpp"
+#include "dynid/types.hpp"
+
+namespace dynid {
+
+enum class Convention { Standard, Modified };
+enum class JointType { Revolute, Prismatic };
+
+// One DH row. Standard: A_{i-1,i} = Rz(theta) Tz(d) Tx(a) Rx(alpha).
+// Modified: the row holds (a_{i-1}, alpha_{i-1}, d_i, theta_i), A = Rx(alpha) Tx(a) Rz(theta) Tz(d).
+// The joint variable adds to theta (revolute) or d (prismatic).
+struct DHRow {
+  double a = 0.0;
+  double alpha = 0.0;
+  double d = 0.0;
+  double theta = 0.0;
+  JointType type = JointType::Revolute;
+};
+
+// Constant part of joint i in the modified form used by the algorithms (joint_transform.hpp).
+struct JointGeometry {
+  double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
+  double theta = 0.0, d = 0.0;  // offsets to which q adds
+  bool revolute = true;
+};
+
+class Model {
+ public:
+  Model(std::vector<DHRow> rows, Convention convention, const Vector3& gravity = Vector3(0, 0, -9.81),
+        const Matrix4& base = Matrix4::Identity(), const Matrix4& tool = Matrix4::Identity());
+
+  int n() const { return n_; }
+  Convention convention() const { return convention_; }
+  const std::vector<DHRow>& dh() const { return rows_; }
+  const Vector3& gravity() const { return gravity_; }
+  const Matrix4& base() const { return base_; }
+  const Matrix4& tool() const { return tool_; }
+  void set_gravity(const Vector3& gravity);
+  void set_base(const Matrix4& base);
+  void set_tool(const Matrix4& tool);
+
+  // Standard parameters, n x 10, row i about the origin of DH frame i (SPEC order).
+  const MatrixX& parameters() const { return parameters_; }
+  void set_parameters(const Eigen::Ref<const MatrixX>& parameters);
+  void set_link(int i, const RigidBodyParameters& body);
+
+  // Drive terms (n each): rotor inertia reflected to the link side, viscous and Coulomb friction.
+  const VectorX& rotor_inertia() const { return Ia_; }
+  const VectorX& viscous_friction() const { return Fv_; }
+  const VectorX& coulomb_friction() const { return Fs_; }
+  void set_rotor_inertia(const VectorIn& Ia);
+  void set_viscous_friction(const VectorIn& Fv);
+  void set_coulomb_friction(const VectorIn& Fs);
+
+  // ---- derived quantities the algorithms use ----
+  const JointGeometry& joint(int i) const { return joints_[i]; }
+  // Link i's parameters about the origin of its joint frame J_i.
+  const RigidBodyParameters& body(int i) const { return bodies_[i]; }
+  // DH frame i = J_i * link_offset(i): identity for modified DH, Tx(a_i) Rx(alpha_i) for standard.
+  const Matrix3& link_offset_rotation(int i) const { return offset_R_[i]; }
+  const Vector3& link_offset_translation(int i) const { return offset_p_[i]; }
+  // Gravity expressed in frame 0 (the base frame).
+  const Vector3& gravity_base() const { return gravity_base_; }
+  // Frame J_n -> tool: link_offset(n-1) * tool.
+  const Matrix4& flange_to_tool() const { return flange_to_tool_; }
+
+ private:
+  void update_bodies();
+  void update_frames();
+
+  int n_;
+  Convention convention_;
+  std::vector<DHRow> rows_;
+  Vector3 gravity_;
+  Matrix4 base_, tool_;
+  MatrixX parameters_;
+  VectorX Ia_, Fv_, Fs_;
+
+  std::vector<JointGeometry> joints_;
+  std::vector<RigidBodyParameters> bodies_;
+  std::vector<Matrix3> offset_R_;
+  std::vector<Vector3> offset_p_;
+  Vector3 gravity_base_;
+  Matrix4 flange_to_tool_;
+};
+
+}  // namespace dynid

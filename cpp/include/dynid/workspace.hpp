@@ -1,0 +1,52 @@
+// Every buffer an evaluation needs, sized once for a model. Algorithms write here instead of
+// allocating, so a sample costs no heap allocation; give each thread its own Workspace.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <vector>
+
+#include "dynid/joint_transform.hpp"
+#include "dynid/model.hpp"
+#include "dynid/rigid_body.hpp"
+#include "dynid/types.hpp"
+
+namespace dynid {
+
+struct Workspace {
+  explicit Workspace(const Model& model);
+
+  // Per-link arrays hold n + 1 entries: index 0 is the base (frame 0), index i is link i
+  // (1-based, as in the notes); X[i] is joint i.
+  int n;
+  // Joint transforms J_{i-1} -> J_i at the current q (kinematics.hpp).
+  std::vector<JointTransform> X;
+
+  // Newton-Euler recursion, all in the joint frames J_i: angular velocity and acceleration,
+  // linear velocity and acceleration of the frame origin, force and moment (about the origin)
+  // that link i-1 exerts on link i.
+  std::vector<Vector3> omega, omegad, v, a, f, mu;
+
+  // World poses of the joint frames (rotation, origin).
+  std::vector<Matrix3> R_world;
+  std::vector<Vector3> p_world;
+
+  // CRBA: composite bodies in the joint frames.
+  std::vector<RigidBodyParameters> composite;
+
+  // Coriolis matrix: world-frame joint axes, their time derivatives, body velocities and the
+  // composite 6x6 inertia and Coriolis-factor sums (coriolis_matrix.cpp).
+  std::vector<Vector6> S, Sdot, body_velocity;
+  std::vector<Matrix6> inertia_sum, coriolis_sum;
+  std::vector<Vector6> column_wrench, row_coriolis, row_inertia;
+
+  // Regressors: the joint axes i <= j as spatial motion vectors [s; l] in frame J_j.
+  std::vector<Vector6> axes;
+
+  // Forward dynamics and scratch.
+  VectorX zeros;  // n zeros, for the recursions called without velocity or acceleration
+  MatrixX M;
+  VectorX bias;
+  Eigen::LLT<MatrixX> cholesky;
+};
+
+}  // namespace dynid

@@ -1,0 +1,42 @@
+#include "dynid/energy.hpp"
+
+#include "dynid/kinematics.hpp"
+
+namespace dynid {
+
+double kinetic_energy(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd) {
+  update_joint_transforms(model, ws, q);
+  const Vector3 z = Vector3::UnitZ();
+  ws.omega[0].setZero();
+  ws.v[0].setZero();
+  double T = 0.0;
+  for (int i = 1; i <= ws.n; ++i) {
+    const JointTransform& X = ws.X[i];
+    const Vector3& w = ws.omega[i - 1];
+    ws.omega[i] = X.rotate_to_child(w);
+    ws.v[i] = X.rotate_to_child(ws.v[i - 1] + w.cross(X.p));
+    if (model.joint(i - 1).revolute)
+      ws.omega[i] += qd[i - 1] * z;
+    else
+      ws.v[i] += qd[i - 1] * z;
+    const RigidBodyParameters& b = model.body(i - 1);
+    const Vector3& wi = ws.omega[i];
+    const Vector3& vi = ws.v[i];
+    T += 0.5 * (b.m * vi.squaredNorm() + wi.dot(b.I * wi)) + vi.dot(wi.cross(b.h));
+    T += 0.5 * model.rotor_inertia()[i - 1] * qd[i - 1] * qd[i - 1];
+  }
+  return T;
+}
+
+double potential_energy(const Model& model, Workspace& ws, const VectorIn& q) {
+  update_joint_transforms(model, ws, q);
+  update_world_frames(model, ws);
+  double U = 0.0;
+  for (int i = 1; i <= ws.n; ++i) {
+    const RigidBodyParameters& b = model.body(i - 1);
+    U -= model.gravity().dot(b.m * ws.p_world[i] + ws.R_world[i] * b.h);
+  }
+  return U;
+}
+
+}  // namespace dynid

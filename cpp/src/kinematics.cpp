@@ -1,0 +1,59 @@
+#include "dynid/kinematics.hpp"
+
+namespace dynid {
+
+void update_joint_transforms(const Model& model, Workspace& ws, const VectorIn& q) {
+  for (int i = 1; i <= ws.n; ++i) {
+    const JointGeometry& j = model.joint(i - 1);
+    const double qi = q[i - 1];
+    if (j.revolute)
+      ws.X[i].set(j.cos_alpha, j.sin_alpha, j.a, qi + j.theta, j.d);
+    else
+      ws.X[i].set(j.cos_alpha, j.sin_alpha, j.a, j.theta, qi + j.d);
+  }
+}
+
+void update_world_frames(const Model& model, Workspace& ws) {
+  ws.R_world[0] = model.base().topLeftCorner<3, 3>();
+  ws.p_world[0] = model.base().topRightCorner<3, 1>();
+  for (int i = 1; i <= ws.n; ++i) {
+    ws.p_world[i] = ws.p_world[i - 1] + ws.R_world[i - 1] * ws.X[i].p;
+    ws.R_world[i] = ws.R_world[i - 1] * ws.X[i].rotation();
+  }
+}
+
+namespace {
+
+Matrix4 tool_pose(const Model& model, const Workspace& ws) {
+  Matrix4 flange = Matrix4::Identity();
+  flange.topLeftCorner<3, 3>() = ws.R_world[ws.n];
+  flange.topRightCorner<3, 1>() = ws.p_world[ws.n];
+  return flange * model.flange_to_tool();
+}
+
+}  // namespace
+
+void fkine(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut T) {
+  update_joint_transforms(model, ws, q);
+  update_world_frames(model, ws);
+  T = tool_pose(model, ws);
+}
+
+void jacobian(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut J) {
+  update_joint_transforms(model, ws, q);
+  update_world_frames(model, ws);
+  const Vector3 tool_point = tool_pose(model, ws).topRightCorner<3, 1>();
+  for (int i = 1; i <= ws.n; ++i) {
+    // Joint i acts along z of J_i (joint_transform.hpp).
+    const Vector3 z = ws.R_world[i].col(2);
+    if (model.joint(i - 1).revolute) {
+      J.col(i - 1).head<3>() = z.cross(tool_point - ws.p_world[i]);
+      J.col(i - 1).tail<3>() = z;
+    } else {
+      J.col(i - 1).head<3>() = z;
+      J.col(i - 1).tail<3>().setZero();
+    }
+  }
+}
+
+}  // namespace dynid

@@ -1,0 +1,160 @@
+#include "dynid/model.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <stdexcept>
+
+namespace dynid {
+namespace {
+
+void require_homogeneous(const Matrix4& T, const char* name) {
+  if (!T.allFinite()) throw std::invalid_argument(std::string(name) + ": non-finite value");
+  const Matrix3 R = T.topLeftCorner<3, 3>();
+  const bool orthonormal = (R.transpose() * R - Matrix3::Identity()).cwiseAbs().maxCoeff() < 1e-6;
+  const bool last_row = (T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() == 0.0;
+  if (!orthonormal || !last_row || R.determinant() < 0.0)
+    throw std::invalid_argument(std::string(name) +
+                                ": expected a homogeneous transform (rotation with det +1, last "
+                                "row [0, 0, 0, 1])");
+}
+
+void require_length(const VectorIn& v, int n, const char* name) {
+  if (v.size() != n)
+    throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(n) +
+                                " values, got " + std::to_string(v.size()));
+  if (!v.allFinite()) throw std::invalid_argument(std::string(name) + ": non-finite value");
+}
+
+Matrix3 rotation_x(double c, double s) {
+  Matrix3 R;
+  R << 1, 0, 0, 0, c, -s, 0, s, c;
+  return R;
+}
+
+}  // namespace
+
+Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& gravity,
+             const Matrix4& base, const Matrix4& tool)
+    : n_(static_cast<int>(rows.size())),
+      convention_(convention),
+      rows_(std::move(rows)),
+      gravity_(Vector3(0, 0, -9.81)),
+      base_(Matrix4::Identity()),
+      tool_(Matrix4::Identity()) {
+  if (n_ < 1) throw std::invalid_argument("dh: a chain needs at least one joint");
+  for (int i = 0; i < n_; ++i) {
+    const DHRow& r = rows_[i];
+    if (!std::isfinite(r.a) || !std::isfinite(r.alpha) || !std::isfinite(r.d) ||
+        !std::isfinite(r.theta))
+      throw std::invalid_argument("dh: row " + std::to_string(i) + " has a non-finite value");
+  }
+  set_gravity(gravity);
+  set_base(base);
+  set_tool(tool);
+  parameters_ = MatrixX::Zero(n_, 10);
+  Ia_ = VectorX::Zero(n_);
+  Fv_ = VectorX::Zero(n_);
+  Fs_ = VectorX::Zero(n_);
+
+  // Bring both conventions to the modified form (joint_transform.hpp). For standard DH the
+  // constant Tx(a_{i-1}) Rx(alpha_{i-1}) of the previous row precedes joint i, and link i's DH
+  // frame sits at J_i * Tx(a_i) Rx(alpha_i).
+  joints_.resize(n_);
+  offset_R_.assign(n_, Matrix3::Identity());
+  offset_p_.assign(n_, Vector3::Zero());
+  for (int i = 0; i < n_; ++i) {
+    const DHRow& r = rows_[i];
+    JointGeometry& j = joints_[i];
+    j.revolute = r.type == JointType::Revolute;
+    j.theta = r.theta;
+    j.d = r.d;
+    double a = 0.0, alpha = 0.0;
+    if (convention_ == Convention::Modified) {
+      a = r.a;
+      alpha = r.alpha;
+    } else if (i > 0) {
+      a = rows_[i - 1].a;
+      alpha = rows_[i - 1].alpha;
+    }
+    j.a = a;
+    j.cos_alpha = std::cos(alpha);
+    j.sin_alpha = std::sin(alpha);
+    if (convention_ == Convention::Standard) {
+      offset_R_[i] = rotation_x(std::cos(r.alpha), std::sin(r.alpha));
+      offset_p_[i] = Vector3(r.a, 0.0, 0.0);
+    }
+  }
+  update_frames();
+  update_bodies();
+}
+
+void Model::set_gravity(const Vector3& gravity) {
+  if (!gravity.allFinite()) throw std::invalid_argument("gravity: non-finite value");
+  gravity_ = gravity;
+  gravity_base_ = base_.topLeftCorner<3, 3>().transpose() * gravity_;
+}
+
+void Model::set_base(const Matrix4& base) {
+  require_homogeneous(base, "base");
+  base_ = base;
+  gravity_base_ = base_.topLeftCorner<3, 3>().transpose() * gravity_;
+}
+
+void Model::set_tool(const Matrix4& tool) {
+  require_homogeneous(tool, "tool");
+  tool_ = tool;
+  if (!offset_R_.empty()) update_frames();
+}
+
+void Model::update_frames() {
+  Matrix4 offset = Matrix4::Identity();
+  offset.topLeftCorner<3, 3>() = offset_R_[n_ - 1];
+  offset.topRightCorner<3, 1>() = offset_p_[n_ - 1];
+  flange_to_tool_ = offset * tool_;
+}
+
+void Model::set_parameters(const Eigen::Ref<const MatrixX>& parameters) {
+  if (parameters.rows() != n_ || parameters.cols() != 10)
+    throw std::invalid_argument("params: expected shape (" + std::to_string(n_) +
+                                ", 10), got (" + std::to_string(parameters.rows()) + ", " +
+                                std::to_string(parameters.cols()) + ")");
+  if (!parameters.allFinite()) throw std::invalid_argument("params: non-finite value");
+  parameters_ = parameters;
+  update_bodies();
+}
+
+void Model::set_link(int i, const RigidBodyParameters& body) {
+  if (i < 0 || i >= n_)
+    throw std::invalid_argument("i: link index " + std::to_string(i) + " out of range [0, " +
+                                std::to_string(n_) + ")");
+  double row[10];
+  body.to_standard(row);
+  for (int k = 0; k < 10; ++k) parameters_(i, k) = row[k];
+  if (!parameters_.row(i).allFinite()) throw std::invalid_argument("params: non-finite value");
+  update_bodies();
+}
+
+void Model::set_rotor_inertia(const VectorIn& Ia) {
+  require_length(Ia, n_, "Ia");
+  Ia_ = Ia;
+}
+void Model::set_viscous_friction(const VectorIn& Fv) {
+  require_length(Fv, n_, "Fv");
+  Fv_ = Fv;
+}
+void Model::set_coulomb_friction(const VectorIn& Fs) {
+  require_length(Fs, n_, "Fs");
+  Fs_ = Fs;
+}
+
+void Model::update_bodies() {
+  bodies_.resize(n_);
+  for (int i = 0; i < n_; ++i) {
+    double row[10];
+    for (int k = 0; k < 10; ++k) row[k] = parameters_(i, k);
+    bodies_[i] = RigidBodyParameters::from_standard(row).expressed_in_parent(offset_R_[i],
+                                                                             offset_p_[i]);
+  }
+}
+
+}  // namespace dynid

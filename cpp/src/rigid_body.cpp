@@ -1,0 +1,75 @@
+#include "dynid/rigid_body.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+namespace dynid {
+
+RigidBodyParameters RigidBodyParameters::from_standard(const double* pi10) {
+  RigidBodyParameters body;
+  body.m = pi10[0];
+  body.h = Vector3(pi10[1], pi10[2], pi10[3]);
+  body.I << pi10[4], pi10[5], pi10[6],  //
+      pi10[5], pi10[7], pi10[8],        //
+      pi10[6], pi10[8], pi10[9];
+  return body;
+}
+
+void RigidBodyParameters::to_standard(double* pi10) const {
+  pi10[0] = m;
+  pi10[1] = h.x();
+  pi10[2] = h.y();
+  pi10[3] = h.z();
+  pi10[4] = I(0, 0);
+  pi10[5] = I(0, 1);
+  pi10[6] = I(0, 2);
+  pi10[7] = I(1, 1);
+  pi10[8] = I(1, 2);
+  pi10[9] = I(2, 2);
+}
+
+RigidBodyParameters RigidBodyParameters::from_physical(double mass, const Vector3& com,
+                                                       const Matrix3& inertia_com) {
+  RigidBodyParameters at_com;
+  at_com.m = mass;
+  at_com.I = inertia_com;
+  return at_com.expressed_in_parent(Matrix3::Identity(), com);
+}
+
+RigidBodyParameters RigidBodyParameters::expressed_in_parent(const Matrix3& R,
+                                                             const Vector3& p) const {
+  // Sum over mass points x_A = R x_B + p of m (|x|^2 E - x x^T), with hr = R h:
+  // R I R^T + 2 (p . hr) E - hr p^T - p hr^T + m (|p|^2 E - p p^T).
+  RigidBodyParameters out;
+  const Vector3 hr = R * h;
+  out.m = m;
+  out.h = hr + m * p;
+  const Matrix3 cross_terms = hr * p.transpose();
+  out.I = R * I * R.transpose() - cross_terms - cross_terms.transpose() +
+          (2.0 * p.dot(hr) + m * p.squaredNorm()) * Matrix3::Identity() - m * p * p.transpose();
+  return out;
+}
+
+Matrix3 RigidBodyParameters::inertia_about_com() const {
+  const Vector3 c = h / m;
+  return I - m * (c.squaredNorm() * Matrix3::Identity() - c * c.transpose());
+}
+
+std::string physical_inconsistency(double mass, const Matrix3& inertia_com) {
+  if (!(mass > 0.0)) return "mass must be positive, got " + std::to_string(mass);
+  const double scale = inertia_com.cwiseAbs().maxCoeff();
+  if ((inertia_com - inertia_com.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
+    return "inertia about the centre of mass must be symmetric";
+  const Vector3 moments = Eigen::SelfAdjointEigenSolver<Matrix3>(inertia_com).eigenvalues();
+  if (!(moments.minCoeff() > 0.0))
+    return "inertia about the centre of mass must be positive definite (smallest principal "
+           "moment " + std::to_string(moments.minCoeff()) + ")";
+  const double slack = 1e-12 * moments.sum();
+  for (int k = 0; k < 3; ++k) {
+    if (moments[(k + 1) % 3] + moments[(k + 2) % 3] < moments[k] - slack)
+      return "principal moments of inertia violate the triangle inequality";
+  }
+  return "";
+}
+
+}  // namespace dynid

@@ -1,0 +1,87 @@
+// Recursive Newton-Euler in the joint frames J_i (Luh-Walker-Paul form, moments about the frame
+// origin so that each link enters through its ten standard parameters, notes "Dynamic parameters
+// of robots 3"). Joint i acts along z of J_i; X[i] maps J_i to J_{i-1}.
+#include "dynid/rnea.hpp"
+
+#include "dynid/kinematics.hpp"
+
+namespace dynid {
+namespace {
+
+double friction_torque(const Model& model, int i, double qd) {
+  const double sign = (qd > 0.0) - (qd < 0.0);
+  return model.viscous_friction()[i] * qd + model.coulomb_friction()[i] * sign;
+}
+
+}  // namespace
+
+void propagate_motion(const Model& model, Workspace& ws, const VectorIn& qd, const VectorIn& qdd,
+                      const Vector3& base_acceleration) {
+  const Vector3 z = Vector3::UnitZ();
+  ws.omega[0].setZero();
+  ws.omegad[0].setZero();
+  ws.a[0] = base_acceleration;
+  for (int i = 1; i <= ws.n; ++i) {
+    const JointTransform& X = ws.X[i];
+    const Vector3& w = ws.omega[i - 1];
+    const Vector3 origin_acc =
+        ws.a[i - 1] + ws.omegad[i - 1].cross(X.p) + w.cross(w.cross(X.p));
+    const Vector3 w_in_i = X.rotate_to_child(w);
+    const Vector3 wd_in_i = X.rotate_to_child(ws.omegad[i - 1]);
+    const double qdi = qd[i - 1], qddi = qdd[i - 1];
+    if (model.joint(i - 1).revolute) {
+      ws.omega[i] = w_in_i + qdi * z;
+      ws.omegad[i] = wd_in_i + qddi * z + qdi * w_in_i.cross(z);
+      ws.a[i] = X.rotate_to_child(origin_acc);
+    } else {
+      ws.omega[i] = w_in_i;
+      ws.omegad[i] = wd_in_i;
+      ws.a[i] = X.rotate_to_child(origin_acc) + 2.0 * qdi * w_in_i.cross(z) + qddi * z;
+    }
+  }
+}
+
+void newton_euler(const Model& model, Workspace& ws, const VectorIn& qd, const VectorIn& qdd,
+                  const Vector3& base_acceleration, VectorOut tau) {
+  propagate_motion(model, ws, qd, qdd, base_acceleration);
+  // Wrench needed to move link i alone, about the origin of J_i.
+  for (int i = 1; i <= ws.n; ++i) {
+    const RigidBodyParameters& b = model.body(i - 1);
+    const Vector3& w = ws.omega[i];
+    ws.f[i] = b.m * ws.a[i] + ws.omegad[i].cross(b.h) + w.cross(w.cross(b.h));
+    ws.mu[i] = b.I * ws.omegad[i] + w.cross(b.I * w) + b.h.cross(ws.a[i]);
+  }
+  accumulate_wrenches(model, ws, tau);
+}
+
+void accumulate_wrenches(const Model& model, Workspace& ws, VectorOut tau) {
+  for (int i = ws.n; i >= 1; --i) {
+    tau[i - 1] = model.joint(i - 1).revolute ? ws.mu[i].z() : ws.f[i].z();
+    if (i > 1) {
+      const JointTransform& X = ws.X[i];
+      const Vector3 f_parent = X.rotate_to_parent(ws.f[i]);
+      ws.f[i - 1] += f_parent;
+      ws.mu[i - 1] += X.rotate_to_parent(ws.mu[i]) + X.p.cross(f_parent);
+    }
+  }
+}
+
+void friction(const Model& model, const VectorIn& qd, VectorOut tau) {
+  for (int i = 0; i < model.n(); ++i) tau[i] = friction_torque(model, i, qd[i]);
+}
+
+void rnea(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
+          const VectorIn& qdd, VectorOut tau) {
+  update_joint_transforms(model, ws, q);
+  newton_euler(model, ws, qd, qdd, -model.gravity_base(), tau);
+  const VectorX& Ia = model.rotor_inertia();
+  for (int i = 0; i < ws.n; ++i) tau[i] += Ia[i] * qdd[i] + friction_torque(model, i, qd[i]);
+}
+
+void coriolis(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
+              VectorOut c) {
+  update_joint_transforms(model, ws, q);
+  newton_euler(model, ws, qd, ws.zeros, Vector3::Zero(), c);
+}
+
+}  // namespace dynid

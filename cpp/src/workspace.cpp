@@ -1,0 +1,31 @@
+#include "dynid/workspace.hpp"
+
+namespace dynid {
+
+Workspace::Workspace(const Model& model)
+    : n(model.n()),
+      X(n + 1),
+      omega(n + 1, Vector3::Zero()),
+      omegad(n + 1, Vector3::Zero()),
+      v(n + 1, Vector3::Zero()),
+      a(n + 1, Vector3::Zero()),
+      f(n + 1, Vector3::Zero()),
+      mu(n + 1, Vector3::Zero()),
+      R_world(n + 1, Matrix3::Identity()),
+      p_world(n + 1, Vector3::Zero()),
+      composite(n + 1),
+      S(n + 1, Vector6::Zero()),
+      Sdot(n + 1, Vector6::Zero()),
+      body_velocity(n + 1, Vector6::Zero()),
+      inertia_sum(n + 1, Matrix6::Zero()),
+      coriolis_sum(n + 1, Matrix6::Zero()),
+      column_wrench(n + 1, Vector6::Zero()),
+      row_coriolis(n + 1, Vector6::Zero()),
+      row_inertia(n + 1, Vector6::Zero()),
+      axes(n + 1, Vector6::Zero()),
+      zeros(VectorX::Zero(n)),
+      M(MatrixX::Zero(n, n)),
+      bias(VectorX::Zero(n)),
+      cholesky(n) {}
+
+}  // namespace dynid

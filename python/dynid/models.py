@@ -1,0 +1,240 @@
+"""Ready-made robot models: the KUKA LWR-IV, the lecture's planar 2R and the PUMA 560.
+
+Each factory returns a fresh :class:`dynid.Robot` built with ``Robot.from_dh``.
+Units are SI, angles in radians, standard inertial parameters as in SPEC §2.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from .robot import Robot
+
+__all__ = ["kuka_lwr4", "planar_2r", "puma560"]
+
+_DEG = np.pi / 180.0
+
+# KUKA LWR-IV, one row per link, CoM and inertia in DH frame i (frames of `kuka_lwr4`):
+#   mass [kg], CoM x y z [m], inertia about the CoM Ixx Iyy Izz Ixy Ixz Iyz [kg m^2]
+# (tensor entries, Ixy = -integral of x*y dm). Plausible values, not identified ones:
+# masses follow the real arm (~2.5 kg per arm link, lighter wrist, ~15 kg in total);
+# every CoM has three non-zero components and every tensor non-zero products so that
+# no parameter vanishes by symmetry and identification tests exercise all columns.
+_LWR4_LINKS = np.array([
+    # m     cx      cy      cz      Ixx      Iyy      Izz      Ixy      Ixz      Iyz
+    [2.85,  0.004, -0.072,  0.058, 0.0192,  0.0061,  0.0168,  0.0004, -0.0003,  0.0011],
+    [2.75, -0.003,  0.058,  0.071, 0.0187,  0.0160,  0.0049, -0.0002,  0.0004, -0.0012],
+    [2.60,  0.005,  0.069,  0.062, 0.0176,  0.0052,  0.0154,  0.0003,  0.0002,  0.0009],
+    [2.55, -0.004, -0.061,  0.068, 0.0171,  0.0148,  0.0047,  0.0002, -0.0003,  0.0010],
+    [1.85,  0.003, -0.063,  0.009, 0.0108,  0.0031,  0.0094, -0.0002,  0.0001, -0.0006],
+    [1.70,  0.002,  0.004,  0.061, 0.0046,  0.0043,  0.0039,  0.0001, -0.0001,  0.0002],
+    [0.45, -0.001,  0.002,  0.065, 0.00052, 0.00047, 0.00071, 0.00004, 0.00003, -0.00005],
+])  # fmt: skip
+
+# Link-side drive terms of the LWR-IV model (plausible, not published): reflected rotor
+# inertia Ia [kg m^2], viscous Fv [N m s/rad] and Coulomb Fs [N m] friction per joint.
+_LWR4_IA = np.array([0.32, 0.30, 0.21, 0.19, 0.11, 0.08, 0.07])
+_LWR4_FV = np.array([0.90, 0.85, 0.55, 0.50, 0.30, 0.25, 0.15])
+_LWR4_FS = np.array([1.10, 1.00, 0.60, 0.55, 0.45, 0.35, 0.20])
+
+# PUMA 560, Corke & Armstrong-Helouvry (ICRA 1994), as in the Robotics Toolbox
+# `mdl_puma560` ("params of 8/95"), one row per link:
+#   a [m], alpha [rad], d [m], mass [kg], CoM x y z [m] in frame i,
+#   Ixx Iyy Izz about the CoM [kg m^2] (products zero)
+_PUMA_LINKS = np.array([
+    # a       alpha       d        m      cx       cy       cz      Ixx      Iyy      Izz
+    [0.0,     np.pi / 2,  0.0,     0.0,   0.0,     0.0,     0.0,    0.0,     0.35,    0.0],
+    [0.4318,  0.0,        0.0,     17.4, -0.3638,  0.006,   0.2275, 0.13,    0.524,   0.539],
+    [0.0203, -np.pi / 2,  0.15005, 4.8,  -0.0203, -0.0141,  0.070,  0.066,   0.086,   0.0125],
+    [0.0,     np.pi / 2,  0.4318,  0.82,  0.0,     0.019,   0.0,    1.8e-3,  1.3e-3,  1.8e-3],
+    [0.0,    -np.pi / 2,  0.0,     0.34,  0.0,     0.0,     0.0,    0.3e-3,  0.4e-3,  0.3e-3],
+    [0.0,     0.0,        0.0,     0.09,  0.0,     0.0,     0.032,  0.15e-3, 0.15e-3, 0.04e-3],
+])  # fmt: skip
+# joint limits [deg], lower and upper per joint (same source)
+_PUMA_QLIM_DEG = np.array(
+    [[-160, 160], [-45, 225], [-225, 45], [-110, 170], [-100, 100], [-266, 266]]
+)
+
+# PUMA 560 drives, motor side: rotor inertia Jm [kg m^2], gear ratio G, viscous friction
+# B [N m s/rad] and Coulomb friction Tc+ / Tc- [N m], per joint (same source).
+_PUMA_DRIVES = np.array([
+    # Jm       G          B         Tc+      Tc-
+    [200e-6, -62.6111,  1.48e-3,  0.395,   -0.435],
+    [200e-6, 107.815,   0.817e-3, 0.126,   -0.071],
+    [200e-6, -53.7063,  1.38e-3,  0.132,   -0.105],
+    [33e-6,   76.0364,  71.2e-6,  11.2e-3, -16.9e-3],
+    [33e-6,   71.923,   82.6e-6,  9.26e-3, -14.5e-3],
+    [33e-6,   76.686,   36.7e-6,  3.96e-3, -10.5e-3],
+])  # fmt: skip
+
+
+def _standard_row(mass: float, com: Sequence[float], inertia_com: np.ndarray) -> np.ndarray:
+    """Standard parameters ``[m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz]`` of one link.
+
+    Steiner (SPEC §2): I = I_c + m (|c|^2 E - c c^T). Used for the PUMA 560, whose published
+    links 1 and 3 are not physically consistent, so ``Robot.set_link`` would refuse them.
+    """
+    c = np.asarray(com, dtype=float)
+    inertia = np.asarray(inertia_com, dtype=float) + mass * (c @ c * np.eye(3) - np.outer(c, c))
+    # np.triu_indices(3) walks xx, xy, xz, yy, yz, zz: exactly the SPEC order
+    return np.concatenate(([mass], mass * c, inertia[np.triu_indices(3)]))
+
+
+def kuka_lwr4() -> Robot:
+    """KUKA LWR-IV with plausible, deliberately non-symmetric inertial parameters.
+
+    Kinematics from Table I of Gaz, Flacco, Ferraguti, De Luca, "Identifying the dynamic
+    model used by the KUKA LWR: a reverse engineering approach", ICRA 2014: standard DH,
+    all a_i = 0 and theta offsets 0, alpha = [pi/2, -pi/2, -pi/2, pi/2, pi/2, -pi/2, 0],
+    d_3 = d1 = 0.4 m and d_5 = d2 = 0.39 m. As in the paper, frame 0 sits at the shoulder
+    (the origin of frame 1) and frame 7 at the wrist centre (the origin of frame 6), so the
+    base-to-shoulder 0.3105 m and the flange offset 0.078 m of the real arm are left out.
+    Gravity is (0, 0, -9.81); joint limits are +-170 deg for joints 1, 3, 5, 7 and +-120 deg
+    for joints 2, 4, 6, as in the arm's URDF (FloBaRoID ``kuka_lwr4.urdf``).
+
+    The inertial parameters are invented but physically consistent (``set_link`` checks
+    each link): masses of 0.45-2.85 kg, 14.75 kg in total, close to the URDF of the real
+    arm; CoM offsets with all three components non-zero; full inertia tensors about the
+    CoM with non-zero products. They are not the values KUKA's controller uses.
+
+    Small plausible drive terms are set too: ``Ia`` (reflected rotor inertia), ``Fv`` and
+    ``Fs`` (link-side viscous and Coulomb friction). For the pure rigid-body arm of the
+    paper, zero them::
+
+        robot.Ia = np.zeros(robot.n)
+        robot.Fv = np.zeros(robot.n)
+        robot.Fs = np.zeros(robot.n)
+
+    Returns
+    -------
+    Robot
+        A 7-DOF robot named ``"KUKA LWR-IV"``.
+    """
+    alpha = np.array([1, -1, -1, 1, 1, -1, 0]) * (np.pi / 2)
+    d = [0.0, 0.0, 0.4, 0.0, 0.39, 0.0, 0.0]
+    dh = np.column_stack([np.zeros(7), alpha, d, np.zeros(7)])
+    limit = np.array([170, 120, 170, 120, 170, 120, 170]) * _DEG
+    robot = Robot.from_dh(
+        dh,
+        joint_types="R" * 7,
+        convention="standard",
+        gravity=(0.0, 0.0, -9.81),
+        qlim=np.column_stack([-limit, limit]),
+        name="KUKA LWR-IV",
+    )
+    for i, (m, cx, cy, cz, ixx, iyy, izz, ixy, ixz, iyz) in enumerate(_LWR4_LINKS):
+        inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        robot.set_link(i, m, (cx, cy, cz), inertia)
+    robot.Ia = _LWR4_IA.copy()
+    robot.Fv = _LWR4_FV.copy()
+    robot.Fs = _LWR4_FS.copy()
+    return robot
+
+
+def planar_2r(
+    l1: float = 1.0,
+    l2: float = 1.0,
+    lc1: float = 0.5,
+    lc2: float = 0.5,
+    m1: float = 1.0,
+    m2: float = 1.0,
+    I1: float | None = None,
+    I2: float | None = None,
+    gravity: Sequence[float] = (0.0, -9.81, 0.0),
+) -> Robot:
+    """Planar 2R arm of the lecture notes ("Dynamic model of robots", Robotics 2, pp. 22-24).
+
+    Standard DH rows ``[l1, 0, 0, 0]`` and ``[l2, 0, 0, 0]``, both joints revolute about the
+    base z axis, motion in the base x-y plane. The default gravity (0, -9.81, 0) makes it a
+    vertical plane (g0 = 9.81 along -y, the notes' model); pass ``(0, 0, -9.81)`` for a
+    horizontal plane, where gravity does no work. No drive terms (Ia = Fv = Fs = 0).
+
+    The CoM of link i lies on the link axis at ``lc_i`` from joint i. Standard DH puts frame
+    i at the distal end of link i, so in frame i the CoM is ``(lc_i - l_i, 0, 0)``.
+
+    Parameters
+    ----------
+    l1, l2 : float
+        Link lengths [m].
+    lc1, lc2 : float
+        Distances of the CoMs from joints 1 and 2 [m] (the notes' d1, d2).
+    m1, m2 : float
+        Link masses [kg], > 0.
+    I1, I2 : float, optional
+        Inertia about the CoM around z [kg m^2], > 0; default ``m l^2 / 12`` (thin rod).
+        Only Izz enters planar motion, but ``set_link`` needs a full, physically consistent
+        tensor: we use ``diag(0.01 Izz, Izz, Izz)``, a slender rod along x (a tiny but
+        positive axial inertia, so it is positive definite and meets the triangle
+        inequalities).
+    gravity : sequence of 3 float
+        Gravity in the base frame [m/s^2].
+
+    Returns
+    -------
+    Robot
+        A 2-DOF robot named ``"planar 2R"``.
+
+    Raises
+    ------
+    ValueError
+        From ``set_link`` if a mass or inertia is not positive.
+    """
+    dh = [[l1, 0.0, 0.0, 0.0], [l2, 0.0, 0.0, 0.0]]
+    robot = Robot.from_dh(
+        dh, joint_types="RR", convention="standard", gravity=tuple(gravity), name="planar 2R"
+    )
+    for i, (length, lc, m, izz) in enumerate(((l1, lc1, m1, I1), (l2, lc2, m2, I2))):
+        izz = m * length**2 / 12.0 if izz is None else izz
+        robot.set_link(i, m, (lc - length, 0.0, 0.0), np.diag([0.01 * izz, izz, izz]))
+    return robot
+
+
+def puma560() -> Robot:
+    """Unimation PUMA 560 with the consensus parameters of Corke and Armstrong-Helouvry.
+
+    Source: P. Corke and B. Armstrong-Helouvry, "A search for consensus among model
+    parameters reported for the PUMA 560 robot", Proc. IEEE ICRA 1994, pp. 1608-1613, in
+    the form of the Robotics Toolbox's ``mdl_puma560`` (standard DH, "params of 8/95");
+    joint limits there from Wang & Chen, IEEE Trans. RA 7(4), 1991. d_1 = 0 as in that
+    model (the shoulder at the origin; the Python toolbox's ``Puma560`` adds the 0.672 m
+    pedestal as d_1, which changes the pose but not the dynamics). Gravity (0, 0, -9.81).
+
+    Drive terms are reflected from the motor side to the link side:
+    ``Ia = Jm G^2``, ``Fv = B G^2`` and ``Fs = |G| (|Tc+| + |Tc-|) / 2``. The toolbox stores
+    an asymmetric Coulomb friction ``Tc = [Tc+, Tc-]``, applied for positive and negative
+    velocity respectively (its inline comment says "[-,+]", but the values and the toolbox's
+    own test torques fit [+, -]); dynid's Coulomb model ``Fs sign(qd)`` is symmetric, so the mean of the two
+    magnitudes is used. Zero ``Ia``, ``Fv``, ``Fs`` for the rigid-body arm alone.
+
+    The published parameters are kept as they are, which makes
+    ``robot.is_physically_consistent()`` False: link 1 has m = 0 (no mass was reported; it
+    does not enter the dynamics, only its inertia 0.35 kg m^2 about the joint-1 axis does,
+    and its Ixx = Izz = 0) and link 3's inertia violates the triangle inequality
+    (Ixx + Izz = 0.0785 < Iyy = 0.086). ``set_link`` would refuse both, so all links are
+    given as standard parameters (Steiner applied here).
+
+    Returns
+    -------
+    Robot
+        A 6-DOF robot named ``"PUMA 560"``; its nominal pose in the toolbox is
+        ``qn = [0, pi/4, pi, 0, pi/4, 0]``.
+    """
+    links = _PUMA_LINKS
+    dh = np.column_stack([links[:, 0], links[:, 1], links[:, 2], np.zeros(6)])
+    params = np.array([_standard_row(row[3], row[4:7], np.diag(row[7:10])) for row in links])
+    robot = Robot.from_dh(
+        dh,
+        joint_types="R" * 6,
+        convention="standard",
+        gravity=(0.0, 0.0, -9.81),
+        params=params,
+        qlim=_PUMA_QLIM_DEG * _DEG,
+        name="PUMA 560",
+    )
+    jm, gear, visc, tc_pos, tc_neg = _PUMA_DRIVES.T
+    robot.Ia = jm * gear**2
+    robot.Fv = visc * gear**2
+    robot.Fs = np.abs(gear) * (np.abs(tc_pos) + np.abs(tc_neg)) / 2.0
+    return robot

@@ -1,0 +1,177 @@
+"""The robot model: a DH chain with its inertial parameters and drive terms.
+
+`Robot` is the C++ model itself (`dynid._core.Model`) with the Python conveniences added on top,
+so a dynamics call such as ``robot.rnea(q, qd, qdd)`` goes straight to C++ with no Python frame in
+between. One sample is an (n,) array, a trajectory a (T, n) array; batches are looped in C++ with
+the GIL released.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _core
+
+PARAMETER_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
+
+
+class Robot(_core.Model):
+    """A serial arm described by a Denavit-Hartenberg table.
+
+    Build one with :meth:`Robot.from_dh` or take one from :mod:`dynid.models`. The dynamics
+    methods (``rnea``, ``mass_matrix``, ``gravity``, ``coriolis``, ``coriolis_matrix``,
+    ``friction``, ``forward_dynamics``, ``kinetic_energy``, ``potential_energy``, ``fkine``,
+    ``jacobian``) accept one sample (n,) or T samples (T, n).
+    """
+
+    @classmethod
+    def from_dh(
+        cls,
+        dh: ArrayLike,
+        joint_types: str | None = None,
+        convention: str = "standard",
+        gravity: ArrayLike = (0.0, 0.0, -9.81),
+        params: ArrayLike | None = None,
+        base: ArrayLike | None = None,
+        tool: ArrayLike | None = None,
+        qlim: ArrayLike | None = None,
+        name: str | None = None,
+    ) -> Robot:
+        """Build a robot from a DH table.
+
+        Parameters
+        ----------
+        dh
+            (n, 4) rows ``[a, alpha, d, theta]``. For ``convention="modified"`` row i holds
+            ``(a_{i-1}, alpha_{i-1}, d_i, theta_i)``. The joint variable adds to theta (revolute)
+            or d (prismatic).
+        joint_types
+            One letter per joint, ``"R"`` or ``"P"``; default all revolute.
+        convention
+            ``"standard"`` (A = Rz Tz Tx Rx) or ``"modified"`` (A = Rx Tx Rz Tz).
+        gravity
+            Gravity acceleration in world coordinates.
+        params
+            Standard parameters, (n, 10) or (10n,); None means zeros.
+        base, tool
+            4x4 homogeneous transforms world -> frame 0 and frame n -> tool.
+        qlim
+            (n, 2) joint limits; default (-pi, pi) for revolute and (-1, 1) m for prismatic joints.
+        name
+            A label for printing.
+        """
+        try:
+            shape = np.shape(dh)
+        except ValueError:
+            shape = "a ragged sequence"
+        if isinstance(dh, str) or len(shape) != 2:
+            raise ValueError(f"dh: expected shape (n, 4) with rows [a, alpha, d, theta], got {shape}")
+        n = shape[0]
+        if joint_types is None:
+            joint_types = "R" * n
+        if not isinstance(joint_types, str):
+            raise ValueError(f"joint_types: expected a string of 'R'/'P', got {joint_types!r}")
+        if not isinstance(convention, str):
+            raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
+        robot = cls(dh, joint_types.upper(), convention, gravity, base, tool)
+        if params is not None:
+            robot.params = params
+        robot.qlim = _default_limits(robot.joint_types) if qlim is None else qlim
+        robot.name = name or f"{n}-dof arm"
+        return robot
+
+    # ---- limits and labels -------------------------------------------------------------------
+    @property
+    def qlim(self) -> NDArray[np.float64]:
+        """Joint limits (n, 2), [lower, upper]."""
+        return self._qlim
+
+    @qlim.setter
+    def qlim(self, value: ArrayLike) -> None:
+        limits = _as_finite(value, "qlim")
+        if limits.shape != (self.n, 2):
+            raise ValueError(f"qlim: expected shape ({self.n}, 2), got {limits.shape}")
+        if np.any(limits[:, 0] >= limits[:, 1]):
+            raise ValueError("qlim: every lower limit must be below its upper limit")
+        limits.setflags(write=False)
+        self._qlim = limits
+
+    def __repr__(self) -> str:
+        return (
+            f"Robot({getattr(self, 'name', '?')!r}, n={self.n}, joints={self.joint_types!r}, "
+            f"convention={self.convention!r})"
+        )
+
+    # ---- parameters ---------------------------------------------------------------------------
+    def set_link(self, i: int, mass: float, com: ArrayLike, inertia_com: ArrayLike) -> None:
+        """Set link ``i`` (0-based) from its physical form.
+
+        ``com`` is the centre of mass in DH frame i and ``inertia_com`` the 3x3 inertia tensor
+        about the centre of mass in frame-i axes; Steiner's theorem gives the standard parameters.
+        Raises ValueError unless m > 0 and the inertia is positive definite and satisfies the
+        triangle inequalities.
+        """
+        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+            raise ValueError(f"i: expected an integer link index, got {i!r}")
+        try:
+            mass_value = float(mass)
+        except (TypeError, ValueError):
+            raise ValueError(f"mass: expected a number, got {mass!r}") from None
+        self._set_link_physical(int(i), mass_value, com, inertia_com)
+
+    def is_physically_consistent(self) -> bool:
+        """True when every link has m > 0 and an inertia about its centre of mass that is
+        positive definite and satisfies the triangle inequalities."""
+        return all(self._link_inconsistency(i) == "" for i in range(self.n))
+
+    def parameter_vector(self, rotor: bool = False, friction: bool = False) -> NDArray[np.float64]:
+        """The parameter vector pi matching the regressor's columns: the 10n standard parameters,
+        then Ia (n) if ``rotor``, then Fv (n) and Fs (n) if ``friction``."""
+        parts = [self.params.reshape(-1)]
+        if rotor:
+            parts.append(self.Ia)
+        if friction:
+            parts += [self.Fv, self.Fs]
+        return np.concatenate(parts)
+
+    def parameter_names(self, rotor: bool = False, friction: bool = False) -> list[str]:
+        """Names of :meth:`parameter_vector`'s entries: m1, mx1, ..., Izz_n, Ia1.., Fv1.., Fs1.."""
+        links = range(1, self.n + 1)
+        names = [f"{field}{i}" for i in links for field in PARAMETER_FIELDS]
+        if rotor:
+            names += [f"Ia{i}" for i in links]
+        if friction:
+            names += [f"Fv{i}" for i in links] + [f"Fs{i}" for i in links]
+        return names
+
+    def copy(self) -> Robot:
+        """An independent copy (parameters, drive terms, limits, transforms)."""
+        other = Robot.from_dh(
+            self.dh, self.joint_types, self.convention, self.gravity_vector, self.params,
+            self.base, self.tool, self.qlim, self.name,
+        )
+        other.Ia, other.Fv, other.Fs = self.Ia, self.Fv, self.Fs
+        return other
+
+    def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
+        """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
+        rng = np.random.default_rng(seed)
+        low, high = self.qlim[:, 0], self.qlim[:, 1]
+        return low + (high - low) * rng.random((count, self.n))
+
+
+def _default_limits(joint_types: Sequence[str]) -> NDArray[np.float64]:
+    return np.array([(-np.pi, np.pi) if t == "R" else (-1.0, 1.0) for t in joint_types])
+
+
+def _as_finite(value: ArrayLike, name: str) -> NDArray[np.float64]:
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected an array of real numbers, got {value!r}") from None
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name}: contains NaN or inf")
+    return array
