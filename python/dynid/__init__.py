@@ -5,7 +5,8 @@ and Coriolis matrices and the regressors; this package holds the user's workflow
 """
 
 from . import models
+from .base_parameters import BaseParameters, base_parameters
 from .robot import Robot
 
-__all__ = ["Robot", "models"]
+__all__ = ["BaseParameters", "Robot", "base_parameters", "models"]
 __version__ = "0.1.0"

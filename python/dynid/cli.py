@@ -15,8 +15,8 @@ def _summary() -> str:
     q = np.zeros(robot.n)
     lines = [
         f"dynid demo: {robot!r}",
-        f"  total mass {robot.params[:, 0].sum():.3f} kg, physically consistent: "
-        f"{robot.is_physically_consistent()}",
+        f"  total mass {robot.params[:, 0].sum():.3f} kg",
+        f"  physically consistent: {robot.is_physically_consistent()}",
         "  gravity torques at q = 0 [N m]: " + np.array2string(robot.gravity(q), precision=3),
         "  diagonal of M(0) [kg m^2]: " + np.array2string(np.diag(robot.mass_matrix(q)), precision=4),
     ]

@@ -72,10 +72,8 @@ class Robot(_core.Model):
         n = shape[0]
         if joint_types is None:
             joint_types = "R" * n
-        if not isinstance(joint_types, str):
-            raise ValueError(f"joint_types: expected a string of 'R'/'P', got {joint_types!r}")
-        if not isinstance(convention, str):
-            raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
+        joint_types = _text(joint_types, "joint_types", "a string of 'R'/'P'")
+        convention = _text(convention, "convention", "'standard' or 'modified'")
         robot = cls(dh, joint_types.upper(), convention, gravity, base, tool)
         if params is not None:
             robot.params = params
@@ -114,7 +112,8 @@ class Robot(_core.Model):
         Raises ValueError unless m > 0 and the inertia is positive definite and satisfies the
         triangle inequalities.
         """
-        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+        valid_index = isinstance(i, (int, np.integer)) and not isinstance(i, (bool, np.bool_))
+        if not valid_index:
             raise ValueError(f"i: expected an integer link index, got {i!r}")
         try:
             mass_value = float(mass)
@@ -161,6 +160,13 @@ class Robot(_core.Model):
         rng = np.random.default_rng(seed)
         low, high = self.qlim[:, 0], self.qlim[:, 1]
         return low + (high - low) * rng.random((count, self.n))
+
+
+def _text(value: object, name: str, expected: str) -> str:
+    # SPEC section 2: every bad argument is a ValueError naming it, wrong types included.
+    if isinstance(value, str):
+        return value
+    raise ValueError(f"{name}: expected {expected}, got {value!r}")
 
 
 def _default_limits(joint_types: Sequence[str]) -> NDArray[np.float64]:
