@@ -143,6 +143,7 @@ def planar_2r(
     I1: float | None = None,
     I2: float | None = None,
     gravity: Sequence[float] = (0.0, -9.81, 0.0),
+    convention: str = "standard",
 ) -> Robot:
     """Planar 2R arm of the lecture notes ("Dynamic model of robots", Robotics 2, pp. 22-24).
 
@@ -170,6 +171,11 @@ def planar_2r(
         inequalities).
     gravity : sequence of 3 float
         Gravity in the base frame [m/s^2].
+    convention : {"standard", "modified"}
+        ``"modified"`` describes the same arm with frames at the joints (rows ``[0, 0, 0, 0]``,
+        ``[l1, 0, 0, 0]``, tool ``Tx(l2)``, CoM ``(lc_i, 0, 0)``): the frames of the notes'
+        linear parametrisation, whose base parameters are ``mx1 + l1*m2``, ``Izz1 + l1**2*m2``,
+        ``mx2``, ``Izz2`` (the notes' a1..a4).
 
     Returns
     -------
@@ -181,13 +187,22 @@ def planar_2r(
     ValueError
         From ``set_link`` if a mass or inertia is not positive.
     """
-    dh = [[l1, 0.0, 0.0, 0.0], [l2, 0.0, 0.0, 0.0]]
+    if convention == "standard":
+        dh, tool = [[l1, 0.0, 0.0, 0.0], [l2, 0.0, 0.0, 0.0]], None
+    elif convention == "modified":
+        dh, tool = [[0.0, 0.0, 0.0, 0.0], [l1, 0.0, 0.0, 0.0]], np.eye(4)
+        tool[0, 3] = l2
+    else:
+        raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
     robot = Robot.from_dh(
-        dh, joint_types="RR", convention="standard", gravity=tuple(gravity), name="planar 2R"
+        dh, joint_types="RR", convention=convention, gravity=tuple(gravity), tool=tool,
+        name="planar 2R",
     )
     for i, (length, lc, m, izz) in enumerate(((l1, lc1, m1, I1), (l2, lc2, m2, I2))):
         izz = m * length**2 / 12.0 if izz is None else izz
-        robot.set_link(i, m, (lc - length, 0.0, 0.0), np.diag([0.01 * izz, izz, izz]))
+        # Frame i sits at the distal end of link i in standard DH, at joint i in modified DH.
+        com_x = lc - length if convention == "standard" else lc
+        robot.set_link(i, m, (com_x, 0.0, 0.0), np.diag([0.01 * izz, izz, izz]))
     return robot
 
 
