@@ -1,9 +1,31 @@
 // dynid._core: the C++ core seen from Python. Nothing but conversions lives in this folder.
 #include <pybind11/pybind11.h>
 
+#include <cmath>
+
 #include "model.hpp"
+
+namespace py = pybind11;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
+  m.def(
+      "standard_parameters",
+      [](double mass, py::handle com, py::handle inertia_com) {
+        using namespace dynid;
+        using namespace dynid::binding;
+        if (!std::isfinite(mass)) throw py::value_error("mass: expected a finite number");
+        const Array c = parse_fixed(com, "com", {3});
+        const Array I = parse_fixed(inertia_com, "inertia_com", {3, 3});
+        const RigidBodyParameters body = RigidBodyParameters::from_physical(
+            mass, Vector3(c.data()[0], c.data()[1], c.data()[2]),
+            Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(I.data()));
+        py::array_t<double> out(10);
+        body.to_standard(out.mutable_data());
+        return out;
+      },
+      py::arg("mass"), py::arg("com"), py::arg("inertia_com"),
+      "The ten standard parameters (about the frame origin, Steiner) of a body given by its mass, "
+      "centre of mass and inertia about the centre of mass; no consistency check.");
 }

@@ -1,12 +1,35 @@
 """dynid: dynamics and identification of robot arms given by Denavit-Hartenberg tables.
 
 The C++ core (``dynid._core``) computes kinematics, inverse and forward dynamics, the inertia
-and Coriolis matrices and the regressors; this package holds the user's workflow on top of it.
+and Coriolis matrices and the regressors; this package holds the user's workflow on top of it:
+a model (``robot``, ``models``), its linear parametrisation (``base_parameters``), data in
+(``io``, ``signal``, ``sim``), identification (``identify``, ``from_controller``, ``excitation``),
+checking the result (``validation``, ``plots``) and the command line (``cli``).
 """
 
 from . import models
 from .base_parameters import BaseParameters, base_parameters
+from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
+from .identify import LeastSquaresResult, RankDeficientError, least_squares
+from .io import Log, load_log, prepare_log, save_log
 from .robot import Robot
+from .sim import VirtualController
 
-__all__ = ["BaseParameters", "Robot", "base_parameters", "models"]
+__all__ = [
+    "BaseParameters",
+    "IdentifiedModel",
+    "LeastSquaresResult",
+    "Log",
+    "RankDeficientError",
+    "Robot",
+    "VirtualController",
+    "base_parameters",
+    "identify_from_controller",
+    "least_squares",
+    "load_log",
+    "models",
+    "payload_mass_estimates",
+    "prepare_log",
+    "save_log",
+]
 __version__ = "0.1.0"

@@ -31,7 +31,11 @@ RANK_TOLERANCE = 1e-8
 
 #: Entries of beta are rounded to this many significant digits: the dependencies are exact
 #: products of DH lengths (e.g. 0.4**2 = 0.16), the least-squares noise is ~1e-13.
-SIGNIFICANT_DIGITS = 10
+SIGNIFICANT_DIGITS = 12
+
+#: Within one dependent column's coefficients, an entry this much smaller than the largest is
+#: treated as an exact zero (genuine ratios are products of DH lengths, far above it).
+NOISE_RATIO = 1e-10
 
 KINDS = ("torque", "gravity", "inertia")
 
@@ -112,16 +116,21 @@ def _compute(robot: Robot, kind: str, rotor: bool, friction: bool) -> BaseParame
     independent = np.flatnonzero(nonzero & (np.abs(np.diag(R)) > RANK_TOLERANCE))
     dependent = np.setdiff1d(np.arange(columns), independent)
 
-    # W[:, dependent] = W[:, independent] @ T, exactly up to rounding.
-    T, *_ = np.linalg.lstsq(W[:, independent], W[:, dependent], rcond=None)
-    T = _round_significant(T)
+    # W[:, dependent] = W[:, independent] @ T, exactly up to rounding. Solved on the scaled
+    # columns (then unscaled) so that columns of very different magnitude keep full precision.
+    T_scaled, *_ = np.linalg.lstsq(scaled[:, independent], scaled[:, dependent], rcond=None)
+    T = T_scaled * norms[dependent] / norms[independent][:, None]
+    # Entries far below the largest of their column are rounding noise of exact zeros.
+    column_size = np.max(np.abs(T), axis=0, initial=0.0)
+    T[np.abs(T) < NOISE_RATIO * column_size] = 0.0
+    T = round_significant(T)
     p = independent.size
     beta = np.zeros((p, columns))
     beta[np.arange(p), independent] = 1.0
     beta[:, dependent] = T
 
     names_std = robot.parameter_names(rotor, friction)
-    expressions = [_expression(row, names_std) for row in beta]
+    expressions = [linear_expression(row, names_std) for row in beta]
     names = [
         names_std[k] + ("R" if np.count_nonzero(beta[j]) > 1 else "")
         for j, k in enumerate(independent)
@@ -140,14 +149,16 @@ def _compute(robot: Robot, kind: str, rotor: bool, friction: bool) -> BaseParame
     )
 
 
-def _round_significant(values: NDArray[np.float64]) -> NDArray[np.float64]:
+def round_significant(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Round to SIGNIFICANT_DIGITS significant digits; tiny entries become exact zeros."""
     flat = [float(f"{x:.{SIGNIFICANT_DIGITS}g}") for x in values.ravel()]
     rounded = np.array(flat).reshape(values.shape)
     rounded[np.abs(rounded) < 10.0 ** (-SIGNIFICANT_DIGITS)] = 0.0
     return rounded
 
 
-def _expression(row: NDArray[np.float64], names: list[str]) -> str:
+def linear_expression(row: NDArray[np.float64], names: list[str]) -> str:
+    """``row @ values`` as Python arithmetic over ``names``, e.g. "mz2 + 0.4*m3 - my3"."""
     terms = []
     for k in np.flatnonzero(row):
         c = float(row[k])

@@ -5,31 +5,22 @@ from __future__ import annotations
 import argparse
 import sys
 
-import numpy as np
-
-from . import models
-
-
-def _summary() -> str:
-    robot = models.kuka_lwr4()
-    q = np.zeros(robot.n)
-    lines = [
-        f"dynid demo: {robot!r}",
-        f"  total mass {robot.params[:, 0].sum():.3f} kg",
-        f"  physically consistent: {robot.is_physically_consistent()}",
-        "  gravity torques at q = 0 [N m]: " + np.array2string(robot.gravity(q), precision=3),
-        "  diagonal of M(0) [kg m^2]: " + np.array2string(np.diag(robot.mass_matrix(q)), precision=4),
-    ]
-    return "\n".join(lines)
+from .demo import run_demo
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="dynid", description=__doc__)
     commands = parser.add_subparsers(dest="command", required=True)
-    commands.add_parser("demo", help="show the built-in KUKA LWR-IV model")
+    demo = commands.add_parser(
+        "demo", help="the KUKA LWR-IV identification of Gaz et al. (ICRA 2014) on a simulated arm"
+    )
+    demo.add_argument("--output", default="dynid-demo", help="output folder (default ./dynid-demo)")
+    demo.add_argument("--train", type=int, default=1000, help="training configurations")
+    demo.add_argument("--validation", type=int, default=200, help="validation configurations")
+    demo.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     if args.command == "demo":
-        print(_summary())
+        run_demo(args.output, train=args.train, validation=args.validation, seed=args.seed)
     return 0
 
 

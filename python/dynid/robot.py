@@ -155,6 +155,31 @@ class Robot(_core.Model):
         other.Ia, other.Fv, other.Fs = self.Ia, self.Fv, self.Fs
         return other
 
+    def with_payload(
+        self, mass: float, com: ArrayLike, inertia: ArrayLike | None = None
+    ) -> Robot:
+        """A copy carrying a rigid payload on the last link (notes, "Rule of change in dynamic
+        parameters").
+
+        ``com`` is the payload's centre of mass in the last DH frame and ``inertia`` its inertia
+        tensor about that centre of mass in frame-n axes (None: a point mass). Only link n's
+        parameters change, additively: m_n + m_L, m_n c_n + m_L c_L and, with both tensors taken
+        about the origin of frame n, I_n + I_L.
+        """
+        inertia = np.zeros((3, 3)) if inertia is None else inertia
+        try:
+            mass_value = float(mass)
+        except (TypeError, ValueError):
+            raise ValueError(f"mass: expected a number, got {mass!r}") from None
+        if not mass_value > 0.0:
+            raise ValueError(f"mass: a payload needs a positive mass, got {mass!r}")
+        payload = _core.standard_parameters(mass_value, com, inertia)
+        other = self.copy()
+        params = other.params.copy()
+        params[-1] += payload
+        other.params = params
+        return other
+
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
         rng = np.random.default_rng(seed)

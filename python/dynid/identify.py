@@ -1,0 +1,320 @@
+"""Least-squares identification of the base parameters from a linear model Y theta = tau.
+
+Lecture (Robotics 2, "Least Squares (LS) identification", p. 27): evaluate the regressor on
+N = nc * n equations, with N >> p, stack them into Y theta = u and solve by pseudoinversion;
+a weighted pseudoinverse accounts for different noise levels. "Additional remarks on LS
+identification" (p. 28): stack "all time evaluations sequenced by the rows" of the original Y
+(all samples of joint 1, then joint 2, ...), and check full column rank numerically.
+
+The pseudoinverse is never formed from the normal equations (Y^T Y)^-1 Y^T, which square the
+condition number: the stacked matrix A is factored A = Q R, and the small triangular factor, its
+columns scaled to unit norm, by the SVD R D^-1 = U S V^T; the one factorisation
+A D^-1 = (Q U) S V^T serves the rank test, the solution and the covariance alike.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import ArrayLike, NDArray
+
+METHODS = ("ols", "wls")
+ON_RANK_DEFICIENT = ("raise", "warn")
+
+#: WLS: a joint's noise variance is floored at this fraction of the largest one, so a joint fitted
+#: exactly (noise-free data, or rows that are identically zero) gets a weight at most 1000 times
+#: that of the noisiest joint instead of an infinite one.
+VARIANCE_FLOOR = 1e-6
+
+#: A parameter is not identifiable when its entry in a null-space direction (column-scaled
+#: coordinates, unit vectors) exceeds this; exact structural dependencies leave ~1e-15 elsewhere.
+IDENTIFIABLE_TOLERANCE = 1e-8
+
+
+class RankDeficientError(ValueError):
+    """The data do not excite all base parameters: the stacked regressor has rank < p."""
+
+
+@dataclass(frozen=True)
+class LeastSquaresResult:
+    """An estimate theta of the p parameters with its uncertainty (see :func:`least_squares`)."""
+
+    theta: NDArray[np.float64]  #: (p,) estimate
+    std: NDArray[np.float64]  #: (p,) standard deviations, sqrt of the covariance diagonal
+    relative_std: NDArray[np.float64]  #: (p,) 100 std / |theta| in percent, inf where theta == 0
+    covariance: NDArray[np.float64]  #: (p, p)
+    condition_number: float  #: of the stacked, weighted matrix solved (unscaled columns)
+    rank: int  #: numerical rank of the column-scaled stacked matrix
+    method: str  #: "ols" or "wls"
+    noise_variance: NDArray[np.float64]  #: (n_groups,) per joint, from the OLS residuals
+    residual_rms: NDArray[np.float64]  #: (n_groups,) per joint RMS of tau - Y theta
+    names: list[str] | None  #: parameter names, if given
+    excluded: tuple[int, ...]  #: joints (0-based) whose rows were left out
+    joints: tuple[int, ...] = ()  #: the joint (0-based) of each entry of the per-joint arrays
+
+    def predict(self, Y: ArrayLike) -> NDArray[np.float64]:
+        """Y (..., p) @ theta: the torques predicted by the estimate."""
+        Y = _finite(Y, "Y")
+        if Y.ndim == 0 or Y.shape[-1] != self.theta.size:
+            raise ValueError(f"Y: expected shape (..., {self.theta.size}), got {Y.shape}")
+        return Y @ self.theta
+
+    def table(self) -> str:
+        """An aligned text table: name, value, standard deviation, relative std in percent."""
+        names = self.names or [f"theta[{k}]" for k in range(self.theta.size)]
+        width = max(9, *(len(name) for name in names))
+        lines = [f"{'parameter':<{width}}  {'value':>13}  {'std':>11}  {'rel.std %':>10}"]
+        for name, value, std, rel in zip(names, self.theta, self.std, self.relative_std):
+            lines.append(f"{name:<{width}}  {value:>13.6g}  {std:>11.4g}  {rel:>10.3g}")
+        return "\n".join(lines)
+
+
+def stack_by_joint(
+    Y: ArrayLike, tau: ArrayLike, exclude_joints: Sequence[int] = ()
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Stack T samples of an n-joint model into A theta = b, sorted by joint (lecture p. 28).
+
+    ``Y`` is (T, n, p) and ``tau`` (T, n); one sample (n, p) / (n,) counts as T = 1. Returns
+    A (rows, p), b (rows,) and group (rows,), the joint of each row: all T samples of the first
+    kept joint in time order, then the next joint, ... The joints (0-based second-axis indices)
+    in ``exclude_joints`` are left out, e.g. ``(0,)`` drops joint 1's gravity row as the paper.
+    """
+    Y3, tau2 = _samples(Y, tau)
+    T, n, p = Y3.shape
+    keep = [j for j in range(n) if j not in _excluded(exclude_joints, n)]
+    A = Y3[:, keep, :].transpose(1, 0, 2).reshape(-1, p)
+    b = tau2[:, keep].T.reshape(-1)
+    group = np.repeat(np.array(keep, dtype=np.int64), T)
+    return np.ascontiguousarray(A), np.ascontiguousarray(b), group
+
+
+def least_squares(
+    Y: ArrayLike,
+    tau: ArrayLike,
+    *,
+    method: str = "ols",
+    exclude_joints: Sequence[int] = (),
+    names: Sequence[str] | None = None,
+    on_rank_deficient: str = "raise",
+    rank_tolerance: float = 1e-10,
+) -> LeastSquaresResult:
+    """Estimate theta in Y theta = tau by ordinary or weighted least squares (lecture p. 27).
+
+    The rows are stacked by :func:`stack_by_joint` (N rows, p columns, N_j rows of joint j).
+
+    ``method="ols"``: theta minimises ||b - A theta||; covariance sigma^2 (A^T A)^-1 with
+    sigma^2 = ||r||^2 / (N - p), with (A^T A)^-1 = D^-1 V S^-2 V^T D^-1 from the factors
+    (p becomes the rank in the rank-deficient case, here and below).
+
+    ``method="wls"``: the per-joint noise variance is estimated from the OLS residuals,
+    sigma_j^2 = ||r_j||^2 / (N_j - p N_j / N): the N - p residual degrees of freedom shared among
+    the joints in proportion to their rows, so the row-weighted mean of the sigma_j^2 is the
+    pooled estimate. Each is unbiased when all joints share the same noise level and leverage;
+    the exact share (N_j minus the trace of joint j's block of the hat matrix) differs little
+    for N >> p, but a much noisier joint leaks into the others' OLS residuals and makes their
+    variances, hence the WLS std, conservative. Variances below ``VARIANCE_FLOOR`` times the largest are raised to it (a joint
+    with exactly zero residual would get an infinite weight); if all are zero, the weights are 1.
+    Rows of joint j are then divided by sigma_j and solved again by the same QR + SVD; the covariance
+    is (A^T W A)^-1 with W = diag(1 / sigma_j^2), taking the estimated variances as known.
+
+    ``noise_variance`` holds the sigma_j^2 above (before the floor) for both methods, and
+    ``residual_rms`` the per-joint RMS residual of the final fit, in torque units; both follow
+    ``joints``, the kept joints in increasing order.
+
+    Rank (lecture p. 28, "numerical check of full column rank"): the number of singular values of
+    the column-scaled matrix above ``rank_tolerance`` times the largest. When it is below p,
+    ``on_rank_deficient="raise"`` raises :class:`RankDeficientError` naming the parameters that
+    carry the unexcited directions; ``"warn"`` issues a RuntimeWarning and returns the truncated-
+    SVD solution, which is the minimum-norm one in column-scaled coordinates (it minimises
+    ||D theta|| with D the column norms, so it does not depend on the parameters' units), with
+    std, relative_std and the covariance rows/columns set to inf for the parameters that enter a
+    null-space direction; the others are identifiable and keep their (pseudo-inverse)
+    covariance. Fewer rows than parameters always raise. With exactly as many rows as the rank
+    there are no degrees of freedom left for the noise: a RuntimeWarning, std = inf.
+
+    ``condition_number`` is the 2-norm condition number of the matrix actually solved (after row
+    exclusion and, for WLS, weighting), with its columns as given, so it depends on the
+    parameters' units; the column-scaled one (unit norms), on which the rank test and the
+    solution are computed, is at most sqrt(p) times the smallest achievable by any column scaling
+    (van der Sluis), and can be much smaller than this one.
+    """
+    method = _choice(method, METHODS, "method")
+    on_rank_deficient = _choice(on_rank_deficient, ON_RANK_DEFICIENT, "on_rank_deficient")
+    if not (isinstance(rank_tolerance, (int, float)) and 0.0 < rank_tolerance < 1.0):
+        raise ValueError(f"rank_tolerance: expected a number in (0, 1), got {rank_tolerance!r}")
+    Y, tau = _samples(Y, tau)
+    excluded = tuple(sorted(_excluded(exclude_joints, Y.shape[1])))
+    A, b, group = stack_by_joint(Y, tau, excluded)
+    rows, p = A.shape
+    if names is not None:
+        names = [str(name) for name in names]
+        if len(names) != p:
+            raise ValueError(f"names: expected {p} names (one per column of Y), got {len(names)}")
+    if rows < p:
+        raise RankDeficientError(
+            f"Y: {rows} stacked rows for {p} parameters; at least {p} rows are needed "
+            f"(the lecture asks for N >> p): use more samples"
+        )
+    joints, member = np.unique(group, return_inverse=True)
+    counts = np.bincount(member)
+
+    def check_rank(rank: int, null: NDArray[np.float64], previous: int) -> None:
+        if rank < min(p, previous):  # warn once per drop (WLS re-checks its weighted matrix)
+            message = _rank_message(rank, p, null, names)
+            if on_rank_deficient == "raise":
+                raise RankDeficientError(message)
+            warnings.warn(message, RuntimeWarning, stacklevel=3)
+
+    # OLS (p. 27): theta = Y^# u through QR + SVD, never the normal equations.
+    theta, unit_cov, rank, null, cond = _svd_solve(A, b, rank_tolerance)
+    check_rank(rank, null, p)
+    residual = b - A @ theta
+    dof = rows - rank
+    if dof == 0:
+        warnings.warn(
+            f"Y: {rows} rows for rank {rank} leave no degrees of freedom to estimate the noise; "
+            "std set to inf (use more samples)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        variance = np.full(joints.size, np.inf)
+    else:  # sigma_j^2 = ||r_j||^2 / (N_j - p N_j / N)
+        variance = np.bincount(member, weights=residual**2) / (counts * dof / rows)
+
+    if dof == 0:
+        covariance = np.full((p, p), np.inf)
+    elif method == "ols":
+        covariance = (residual @ residual / dof) * unit_cov
+    else:  # WLS (p. 27, weighted pseudoinverse): rows of joint j divided by sigma_j
+        largest = variance.max()
+        floored = np.maximum(variance, VARIANCE_FLOOR * largest)
+        if largest == 0:  # every joint fitted exactly: equal weights
+            floored = np.ones_like(variance)
+        weight = 1.0 / np.sqrt(floored)[member]
+        ols_rank = rank
+        theta, unit_cov, rank, null, cond = _svd_solve(
+            A * weight[:, None], b * weight, rank_tolerance
+        )
+        check_rank(rank, null, ols_rank)
+        covariance = unit_cov if largest > 0 else np.zeros((p, p))
+        residual = b - A @ theta
+
+    if rank < p:  # parameters entering a null direction have no finite variance
+        free = np.abs(null).max(axis=1) > IDENTIFIABLE_TOLERANCE
+        covariance = covariance.copy()
+        covariance[free, :] = np.inf
+        covariance[:, free] = np.inf
+    std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        relative = np.where(theta != 0, 100.0 * std / np.abs(theta), np.inf)
+    return LeastSquaresResult(
+        theta=theta,
+        std=std,
+        relative_std=relative,
+        covariance=covariance,
+        condition_number=cond,
+        rank=rank,
+        method=method,
+        noise_variance=variance,
+        residual_rms=np.sqrt(np.bincount(member, weights=residual**2) / counts),
+        names=names,
+        excluded=excluded,
+        joints=tuple(int(j) for j in joints),
+    )
+
+
+def _svd_solve(
+    A: NDArray[np.float64], b: NDArray[np.float64], tolerance: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64], int, NDArray[np.float64], float]:
+    """theta, (A^T A)^+, rank, null-space basis (scaled coordinates) and cond(A).
+
+    A = Q R (economic QR of the tall stack), then the small SVD R D^-1 = U S V^T with D the
+    column norms, so that A D^-1 = (Q U) S V^T. Over the r singular values above
+    tolerance * s_max: theta = D^-1 V_r S_r^-1 U_r^T Q^T b, (A^T A)^+ = D^-1 V_r S_r^-2 V_r^T D^-1.
+    """
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0  # an all-zero column keeps a zero singular value
+    Q, R = scipy.linalg.qr(A, mode="economic")
+    U, s, Vt = scipy.linalg.svd(R / scale, lapack_driver="gesvd")
+    rank = int(np.count_nonzero(s > tolerance * s[0])) if s[0] > 0 else 0
+    V = Vt[:rank].T / s[:rank]  # V_r S_r^-1
+    theta = (V @ (U[:, :rank].T @ (Q.T @ b))) / scale
+    unit_cov = (V @ V.T) / np.outer(scale, scale)
+    unscaled = scipy.linalg.svdvals(R)  # the singular values of A
+    cond = float(unscaled[0] / unscaled[-1]) if unscaled[-1] > 0 else np.inf
+    return theta, unit_cov, rank, Vt[rank:].T, cond
+
+
+def _rank_message(rank: int, p: int, null: NDArray[np.float64], names: list[str] | None) -> str:
+    # The right-singular vectors of the zero singular values are the parameter combinations the
+    # data cannot see; their largest entries name the least excited parameters.
+    label = names or [f"theta[{k}]" for k in range(p)]
+    weight = np.linalg.norm(null, axis=1)
+    order = [k for k in np.argsort(-weight, kind="stable") if weight[k] > 0.3 * weight.max()][:8]
+    direction = null[:, 0]
+    terms = [
+        k for k in np.argsort(-np.abs(direction), kind="stable")[:4] if abs(direction[k]) > 0.1
+    ]
+    combination = " ".join(f"{direction[k]:+.3g}*{label[k]}" for k in terms)
+    return (
+        f"Y: the data do not excite all base parameters: rank {rank} < {p} "
+        f"({p - rank} unexcited direction(s)); least excited: {', '.join(label[k] for k in order)} "
+        f"(e.g. the combination {combination} of the column-scaled parameters has no effect on "
+        "the torques). Use more varied data (more configurations, different values of every "
+        "joint, richer velocities and accelerations)."
+    )
+
+
+def _samples(Y: ArrayLike, tau: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    Y = _finite(Y, "Y")
+    tau = _finite(tau, "tau")
+    if Y.ndim == 2:  # one sample (n, p)
+        Y = Y[np.newaxis]
+    if Y.ndim != 3 or 0 in Y.shape:
+        raise ValueError(f"Y: expected a non-empty (T, n, p) or (n, p) array, got shape {Y.shape}")
+    expected = Y.shape[:2]
+    if tau.ndim == 1 and expected[0] == 1:
+        tau = tau[np.newaxis]
+    if tau.shape != expected:
+        raise ValueError(f"tau: expected shape {expected} to match Y {Y.shape}, got {tau.shape}")
+    return Y, tau
+
+
+def _excluded(exclude_joints: Sequence[int], n: int) -> set[int]:
+    try:
+        values = list(exclude_joints)
+    except TypeError:
+        raise ValueError(
+            f"exclude_joints: expected a sequence of joint indices, got {exclude_joints!r}"
+        ) from None
+    for j in values:
+        integer = isinstance(j, (int, np.integer)) and not isinstance(j, (bool, np.bool_))
+        if not integer or not 0 <= j < n:
+            raise ValueError(
+                f"exclude_joints: expected 0-based joint indices in [0, {n}), got {exclude_joints!r}"
+            )
+    if len(set(values)) == n:
+        raise ValueError(f"exclude_joints: {exclude_joints!r} leaves no joint of {n}")
+    return {int(j) for j in values}
+
+
+def _choice(value: object, options: tuple[str, ...], name: str) -> str:
+    if not isinstance(value, str) or value not in options:
+        raise ValueError(f"{name}: expected one of {options}, got {value!r}")
+    return value
+
+
+def _finite(value: ArrayLike, name: str) -> NDArray[np.float64]:
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"{name}: expected an array of real numbers, got {type(value).__name__}"
+        ) from None
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name}: contains NaN or inf")
+    return array

@@ -1,0 +1,72 @@
+"""Checking an identified model: per-joint error metrics and the paper's table layout."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+
+def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArray[np.float64]]:
+    """Per-column (joint) errors of ``predicted`` against ``measured``, both (T, n).
+
+    Returns ``mse`` (mean square error, paper Table II), ``max_abs`` (maximum absolute error,
+    Table III), ``rms``, ``relative_rms`` (rms error / rms of the measurement) and ``r2``
+    (coefficient of determination, 1 - SSE / SST about the mean; NaN-free: 1.0 for a constant
+    signal predicted exactly, -inf if it is not).
+    """
+    measured = np.atleast_2d(np.asarray(measured, dtype=float))
+    predicted = np.atleast_2d(np.asarray(predicted, dtype=float))
+    if measured.shape != predicted.shape:
+        raise ValueError(
+            f"predicted: expected the shape of measured {measured.shape}, got {predicted.shape}"
+        )
+    if not (np.all(np.isfinite(measured)) and np.all(np.isfinite(predicted))):
+        raise ValueError("measured, predicted: contain NaN or inf")
+    error = predicted - measured
+    sse = np.sum(error**2, axis=0)
+    sst = np.sum((measured - measured.mean(axis=0)) ** 2, axis=0)
+    rms_measured = np.sqrt(np.mean(measured**2, axis=0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r2 = np.where(sst > 0.0, 1.0 - sse / sst, np.where(sse == 0.0, 1.0, -np.inf))
+        relative = np.where(rms_measured > 0.0, np.sqrt(np.mean(error**2, axis=0)) / rms_measured,
+                            np.where(sse == 0.0, 0.0, np.inf))
+    return {
+        "mse": np.mean(error**2, axis=0),
+        "max_abs": np.max(np.abs(error), axis=0),
+        "rms": np.sqrt(np.mean(error**2, axis=0)),
+        "relative_rms": relative,
+        "r2": r2,
+    }
+
+
+def paper_table(
+    title: str,
+    columns: Mapping[str, ArrayLike],
+    excluded: Sequence[int] = (),
+    fmt: str = "{:.2e}",
+) -> str:
+    """A table in the layout of the paper's Tables II and III: one row per joint (J1, J2, ...),
+    one column per data set (e.g. TS, VS, TVE); excluded joints show a dash."""
+    names = list(columns)
+    values = [np.asarray(columns[name], dtype=float) for name in names]
+    n = len(values[0])
+    width = max(10, *(len(name) + 2 for name in names))
+    lines = [title, "      " + "".join(f"{name:>{width}}" for name in names)]
+    for j in range(n):
+        cells = ["–" if j in excluded else fmt.format(v[j]) for v in values]
+        lines.append(f"  J{j + 1:<3}" + "".join(f"{c:>{width}}" for c in cells))
+    return "\n".join(lines)
+
+
+def validation_table(metrics: Mapping[str, NDArray[np.float64]], unit: str = "N m") -> str:
+    """Per-joint RMS, relative RMS, maximum error and R^2 as an aligned text table."""
+    n = len(metrics["rms"])
+    lines = [f"  joint   rms [{unit}]   rel. rms   max [{unit}]        R2"]
+    for j in range(n):
+        lines.append(
+            f"  J{j + 1:<5}{metrics['rms'][j]:>11.4g}{100 * metrics['relative_rms'][j]:>10.2f}%"
+            f"{metrics['max_abs'][j]:>12.4g}{metrics['r2'][j]:>10.4f}"
+        )
+    return "\n".join(lines)
