@@ -4,12 +4,14 @@
 #include <cmath>
 
 #include "model.hpp"
+#include "recursive_least_squares.hpp"
 
 namespace py = pybind11;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
+  dynid::binding::bind_recursive_least_squares(m);
   m.def(
       "standard_parameters",
       [](double mass, py::handle com, py::handle inertia_com) {
@@ -28,4 +30,14 @@ PYBIND11_MODULE(_core, m) {
       py::arg("mass"), py::arg("com"), py::arg("inertia_com"),
       "The ten standard parameters (about the frame origin, Steiner) of a body given by its mass, "
       "centre of mass and inertia about the centre of mass; no consistency check.");
+  m.def(
+      "physical_inconsistency",
+      [](double mass, py::handle inertia_com) {
+        using namespace dynid::binding;
+        const Array I = parse_fixed(inertia_com, "inertia_com", {3, 3});
+        return dynid::physical_inconsistency(
+            mass, Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(I.data()));
+      },
+      py::arg("mass"), py::arg("inertia_com"),
+      "Why a body of this mass and inertia about its centre of mass cannot exist ('' if it can).");
 }

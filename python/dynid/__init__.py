@@ -12,6 +12,7 @@ from .base_parameters import BaseParameters, base_parameters
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .io import Log, load_log, prepare_log, save_log
+from .recursive import RecursiveLeastSquares
 from .robot import Robot
 from .sim import VirtualController
 
@@ -21,6 +22,7 @@ __all__ = [
     "LeastSquaresResult",
     "Log",
     "RankDeficientError",
+    "RecursiveLeastSquares",
     "Robot",
     "VirtualController",
     "base_parameters",

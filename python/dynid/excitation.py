@@ -165,11 +165,15 @@ class FourierTrajectory:
         values = _finite_array(x, "x")
         size = n * (2 * harmonics + 1)
         if values.shape != (size,):
-            raise ValueError(f"x: expected shape ({size},) for n={n}, H={harmonics}, got {values.shape}")
+            raise ValueError(
+                f"x: expected shape ({size},) for n={n}, H={harmonics}, got {values.shape}"
+            )
         nh = n * harmonics
         return FourierTrajectory(
-            base_frequency, values[:nh].reshape(n, harmonics),
-            values[nh : 2 * nh].reshape(n, harmonics), values[2 * nh :],
+            base_frequency,
+            values[:nh].reshape(n, harmonics),
+            values[nh : 2 * nh].reshape(n, harmonics),
+            values[2 * nh :],
         )
 
 
@@ -184,7 +188,8 @@ class LimitMargins:
     @property
     def satisfied(self) -> bool:
         return bool(
-            np.all(self.position >= 0) and np.all(self.velocity >= 0)
+            np.all(self.position >= 0)
+            and np.all(self.velocity >= 0)
             and np.all(self.acceleration >= 0)
         )
 
@@ -210,9 +215,14 @@ def excitation_condition_number(
     samples: int = 200,
     rotor: bool = False,
     friction: bool = False,
+    scaled: bool = True,
 ) -> float:
     """Condition number of the stacked base regressor on ``samples`` equally spaced points of
-    one period, each column scaled to unit norm (inf when the motion leaves a column zero)."""
+    one period, each column scaled to unit norm (inf when the motion leaves a column zero).
+
+    ``scaled=False`` gives the plain 2-norm condition number instead, the one
+    :func:`dynid.identify.least_squares` reports; it depends on the parameters' units.
+    """
     if trajectory.n != robot.n:
         raise ValueError(f"trajectory: expected {robot.n} joints, got {trajectory.n}")
     base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
@@ -224,7 +234,11 @@ def excitation_condition_number(
         )
     _, q, qd, qdd = trajectory.sample(count)
     W = base.reduce(robot.regressor(q, qd, qdd, rotor=rotor, friction=friction))
-    _, _, s, _ = _scaled_singular_values(W.reshape(-1, base.count))
+    W = W.reshape(-1, base.count)
+    if scaled:
+        s = _scaled_singular_values(W)[2]
+    else:
+        s = np.linalg.svd(W, compute_uv=False)[::-1]
     return float(s[-1] / s[0]) if s[0] > 0 else float("inf")
 
 
@@ -283,7 +297,9 @@ def optimize_excitation(
     acc = _limit_vector(DEFAULT_QDD_MAX if qdd_max is None else qdd_max, "qdd_max", n)
     margin = _finite_array(position_margin, "position_margin")
     if margin.ndim != 0 or not 0.0 <= margin < 0.5:
-        raise ValueError(f"position_margin: expected a fraction in [0, 0.5), got {position_margin!r}")
+        raise ValueError(
+            f"position_margin: expected a fraction in [0, 0.5), got {position_margin!r}"
+        )
     span = robot.qlim[:, 1] - robot.qlim[:, 0]
     low, high = robot.qlim[:, 0] + margin * span, robot.qlim[:, 1] - margin * span
     wf = 2.0 * np.pi / period
@@ -307,10 +323,19 @@ def optimize_excitation(
     x0 = start.to_vector()
     if maxiter > 0:
         result = minimize(
-            objective.value, x0, jac=objective.gradient, method="SLSQP",
-            constraints=constraints, options={"maxiter": maxiter, "ftol": TOLERANCE},
+            objective.value,
+            x0,
+            jac=objective.gradient,
+            method="SLSQP",
+            constraints=constraints,
+            options={"maxiter": maxiter, "ftol": TOLERANCE},
         )
-        x, iterations, success, message = result.x, int(result.nit), bool(result.success), result.message
+        x, iterations, success, message = (
+            result.x,
+            int(result.nit),
+            bool(result.success),
+            result.message,
+        )
     else:
         x, iterations, success, message = x0, 0, False, "maxiter = 0: the initial guess"
 
@@ -345,8 +370,14 @@ class _LogCondition:
     """
 
     def __init__(
-        self, robot: Robot, base: BaseParameters, t: NDArray[np.float64], wf: float,
-        harmonics: int, rotor: bool, friction: bool,
+        self,
+        robot: Robot,
+        base: BaseParameters,
+        t: NDArray[np.float64],
+        wf: float,
+        harmonics: int,
+        rotor: bool,
+        friction: bool,
     ) -> None:
         self.robot, self.base, self.rotor, self.friction = robot, base, rotor, friction
         self.n, self.harmonics, self.T = robot.n, harmonics, t.size
@@ -387,7 +418,9 @@ class _LogCondition:
         Ws, r, s, V = self._Ws, self._r, self._s, self._V
         s_min, v_min, v_max = max(s[0], 1e-300), V[:, 0], V[:, -1]
         # G = d log(s_max / s_min) / dW, (T n) x p
-        G = np.outer(Ws @ v_max / s[-1] ** 2, v_max / r) - np.outer(Ws @ v_min / s_min**2, v_min / r)
+        G = np.outer(Ws @ v_max / s[-1] ** 2, v_max / r) - np.outer(
+            Ws @ v_min / s_min**2, v_min / r
+        )
         G -= Ws * ((v_max**2 - v_min**2) / r)
         G_full = np.zeros(self._Y.shape)
         G_full[..., self.columns[self.smooth]] = G.reshape(self.T, self.n, -1)[..., self.smooth]
@@ -487,8 +520,10 @@ def _extents(trajectory: FourierTrajectory, samples: int) -> tuple[NDArray[np.fl
     slack = eps / (1.0 - eps) * np.abs(p).max(axis=0)
     inflate = 1.0 / (1.0 - eps)
     return (
-        p.max(axis=0) + slack, (-p).max(axis=0) + slack,
-        inflate * np.abs(qd).max(axis=0), inflate * np.abs(qdd).max(axis=0),
+        p.max(axis=0) + slack,
+        (-p).max(axis=0) + slack,
+        inflate * np.abs(qd).max(axis=0),
+        inflate * np.abs(qdd).max(axis=0),
     )
 
 
@@ -517,7 +552,12 @@ def _scaled(trajectory: FourierTrajectory, scale: float) -> FourierTrajectory:
 
 
 def _random_start(
-    rng: np.random.Generator, n: int, harmonics: int, wf: float, low: NDArray, high: NDArray,
+    rng: np.random.Generator,
+    n: int,
+    harmonics: int,
+    wf: float,
+    low: NDArray,
+    high: NDArray,
     at_rest: bool,
 ) -> FourierTrajectory:
     """Random amplitudes falling as 1/l (each harmonic then adds a similar acceleration) and a
@@ -531,8 +571,13 @@ def _random_start(
 
 
 def _check_initial(
-    initial: FourierTrajectory, n: int, harmonics: int, period: float, low: NDArray,
-    high: NDArray, at_rest: bool,
+    initial: FourierTrajectory,
+    n: int,
+    harmonics: int,
+    period: float,
+    low: NDArray,
+    high: NDArray,
+    at_rest: bool,
 ) -> FourierTrajectory:
     if not isinstance(initial, FourierTrajectory):
         # SPEC section 2: a wrong type is a ValueError too

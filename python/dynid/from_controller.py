@@ -26,7 +26,7 @@ from .base_parameters import (
     linear_expression,
     round_significant,
 )
-from .identify import LeastSquaresResult, least_squares
+from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .robot import Robot
 
 #: An element of M counts as identically zero when |M_ij| <= this * max|M| in every sample.
@@ -112,7 +112,7 @@ def identify_from_controller(
     M: ArrayLike,
     *,
     exclude_gravity_joints: Sequence[int] = (0,),
-    method: str = "ols",
+    method: str = "wls",
 ) -> IdentifiedModel:
     """Identify the gravity and inertia coefficients from controller readings (Sect. V).
 
@@ -126,7 +126,10 @@ def identify_from_controller(
     exclude_gravity_joints
         0-based joints whose gravity component is left out (paper: joint 1, Sect. VI-1).
     method
-        ``"ols"`` or ``"wls"`` (see :func:`dynid.identify.least_squares`).
+        ``"wls"`` (default) or ``"ols"`` (see :func:`dynid.identify.least_squares`). The
+        controller's numeric errors grow with the values, differently for each element of g and
+        M, so weighting each element by its own residual variance gives honest standard
+        deviations where the pooled variance of OLS understates them.
     """
     n = structure.n
     q = _samples(q, "q", (n,))
@@ -147,8 +150,16 @@ def identify_from_controller(
     stack = M[:, rows, cols]  # the inertia stack m(q), eq. (18)
     Ym = inertia_base.reduce(structure.inertia_regressor(q))  # (N, n(n+1)/2, p_m), eq. (22)
     zero_elements, null_space = _zero_elements(M, Ym, inertia_base, rows, cols)
-    reduced = least_squares(Ym @ null_space, stack, method=method)
-    inertia_fit = _expand(reduced, null_space, inertia_base.names)
+    if not zero_elements:
+        inertia_fit = least_squares(Ym, stack, method=method, names=inertia_base.names)
+    else:
+        try:
+            reduced = least_squares(Ym @ null_space, stack, method=method)
+        except RankDeficientError:
+            # Name the unexcited coefficients: the unconstrained fit fails the same way.
+            least_squares(Ym, stack, method=method, names=inertia_base.names)
+            raise
+        inertia_fit = _expand(reduced, null_space, inertia_base.names)
 
     return IdentifiedModel(
         structure=structure.copy(),
@@ -238,7 +249,9 @@ def _zero_elements(
     C = np.vstack(constraints)
     _, s, vt = np.linalg.svd(C)
     rank = int(np.sum(s > 1e-10 * s[0]))
-    return found, vt[rank:].T
+    basis = vt[rank:].T
+    basis[np.abs(basis) < 1e-12] = 0.0  # constrained coefficients come out exactly zero
+    return found, basis
 
 
 def _echelon(rows: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -261,10 +261,10 @@ def _rank_message(rank: int, p: int, null: NDArray[np.float64], names: list[str]
     ]
     combination = " ".join(f"{direction[k]:+.3g}*{label[k]}" for k in terms)
     return (
-        f"Y: the data do not excite all base parameters: rank {rank} < {p} "
+        f"the data do not excite all base parameters: the stacked regressor has rank {rank} < {p} "
         f"({p - rank} unexcited direction(s)); least excited: {', '.join(label[k] for k in order)} "
         f"(e.g. the combination {combination} of the column-scaled parameters has no effect on "
-        "the torques). Use more varied data (more configurations, different values of every "
+        "the data). Use more varied data (more configurations, different values of every "
         "joint, richer velocities and accelerations)."
     )
 

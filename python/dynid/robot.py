@@ -166,13 +166,21 @@ class Robot(_core.Model):
         parameters change, additively: m_n + m_L, m_n c_n + m_L c_L and, with both tensors taken
         about the origin of frame n, I_n + I_L.
         """
-        inertia = np.zeros((3, 3)) if inertia is None else inertia
         try:
             mass_value = float(mass)
         except (TypeError, ValueError):
             raise ValueError(f"mass: expected a number, got {mass!r}") from None
-        if not mass_value > 0.0:
-            raise ValueError(f"mass: a payload needs a positive mass, got {mass!r}")
+        if not (np.isfinite(mass_value) and mass_value > 0.0):
+            raise ValueError(f"mass: a payload needs a positive, finite mass, got {mass!r}")
+        if inertia is None:
+            inertia = np.zeros((3, 3))
+        else:
+            inertia = _as_finite(inertia, "inertia")
+            if inertia.shape != (3, 3):
+                raise ValueError(f"inertia: expected shape (3, 3), got {inertia.shape}")
+            why = _core.physical_inconsistency(mass_value, inertia)
+            if why:
+                raise ValueError(f"inertia: the payload is not physically possible: {why}")
         payload = _core.standard_parameters(mass_value, com, inertia)
         other = self.copy()
         params = other.params.copy()

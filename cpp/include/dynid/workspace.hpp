@@ -33,11 +33,15 @@ struct Workspace {
   // CRBA: composite bodies in the joint frames.
   std::vector<RigidBodyParameters> composite;
 
-  // Coriolis matrix: world-frame joint axes, their time derivatives, body velocities and the
-  // composite 6x6 inertia and Coriolis-factor sums (coriolis_matrix.cpp).
+  // Coriolis matrix (coriolis_matrix.cpp): world-frame joint axes S_k, their derivatives, body
+  // velocities, and per link the sums over the outboard links of the spatial inertias and of
+  // the Coriolis factors' non-zero blocks (a 3x3 block and a momentum vector).
   std::vector<Vector6> S, Sdot, body_velocity;
-  std::vector<Matrix6> inertia_sum, coriolis_sum;
-  std::vector<Vector6> column_wrench, row_coriolis, row_inertia;
+  std::vector<RigidBodyParameters> inertia_sum;
+  std::vector<Matrix3> coriolis_block_sum;
+  std::vector<Vector3> momentum_sum;
+  std::vector<Vector6> column_wrench, row_inertia;
+  std::vector<Vector3> row_coriolis;
 
   // Regressors: the joint axes i <= j as spatial motion vectors [s; l] in frame J_j.
   std::vector<Vector6> axes;

@@ -1,0 +1,281 @@
+// Binding of the recursive least squares estimator: argument checks, the single-block update and
+// the batch update looped in C++ with the GIL released. The recursion itself is in
+// cpp/src/recursive_least_squares.cpp.
+#include "recursive_least_squares.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "arrays.hpp"
+#include "dynid/recursive_least_squares.hpp"
+
+namespace dynid::binding {
+namespace {
+
+using RLS = RecursiveLeastSquares;
+using BlockMap = Eigen::Map<const MatrixX, 0, Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>>;
+
+// A row-major (m, p) block of a NumPy array, read in place.
+BlockMap block(const double* data, Eigen::Index m, Eigen::Index p) {
+  return BlockMap(data, m, p, Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>(1, p));
+}
+
+std::string shape_of(std::initializer_list<py::ssize_t> dims) {
+  std::string s = "(";
+  for (py::ssize_t d : dims) s += (s.size() > 1 ? ", " : "") + std::to_string(d);
+  return s + (dims.size() == 1 ? ",)" : ")");
+}
+
+// SPEC section 2: a wrong type is a ValueError naming the argument too, not pybind11's TypeError.
+// The dtype kind of a scalar argument ('i', 'u', 'f', 'b', ...), '\0' when it is not a scalar;
+// NumPy scalars and 0-d arrays count as scalars.
+char scalar_kind(py::handle obj) {
+  py::array a = py::array::ensure(obj);
+  if (!a) PyErr_Clear();
+  return a && a.ndim() == 0 ? a.dtype().kind() : '\0';
+}
+
+int parse_count(py::handle obj, const char* name) {
+  const char kind = scalar_kind(obj);
+  if (kind != 'i' && kind != 'u')
+    throw py::value_error(std::string(name) + ": expected an integer, got " +
+                          std::string(py::repr(obj)));
+  const py::int_ value(py::reinterpret_borrow<py::object>(obj));  // __index__
+  if (value < py::int_(1))
+    throw py::value_error(std::string(name) + ": expected an integer >= 1, got " +
+                          std::string(py::repr(obj)));
+  if (value > py::int_(std::numeric_limits<int>::max()))
+    throw py::value_error(std::string(name) + ": too large, got " + std::string(py::repr(obj)));
+  return value.cast<int>();
+}
+
+double parse_number(py::handle obj, const char* name) {
+  const char kind = scalar_kind(obj);
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::value_error(std::string(name) + ": expected a number, got " +
+                          std::string(py::repr(obj)));
+  return py::float_(py::reinterpret_borrow<py::object>(obj)).cast<double>();
+}
+
+bool parse_flag(py::handle obj, const char* name) {
+  if (scalar_kind(obj) != 'b')
+    throw py::value_error(std::string(name) + ": expected True or False, got " +
+                          std::string(py::repr(obj)));
+  return PyObject_IsTrue(obj.ptr()) == 1;
+}
+
+// The core names the C++ arguments (P0); the Python user passed initial_covariance.
+template <class Call>
+void with_python_names(Call call) {
+  try {
+    call();
+  } catch (const std::invalid_argument& e) {
+    std::string message = e.what();
+    if (message.rfind("P0:", 0) == 0) message = "initial_covariance:" + message.substr(3);
+    throw py::value_error(message);
+  }
+}
+
+// The initial state: initial_covariance a scalar c (P_0 = c I) or a (p, p) matrix, theta0 None
+// (zeros) or (p,).
+void set_initial_state(RLS& rls, py::handle initial_covariance, py::handle theta0) {
+  const int p = rls.p();
+  Array P0 = as_real_array(initial_covariance, "initial_covariance");
+  if (P0.ndim() != 0 && !(P0.ndim() == 2 && P0.shape(0) == p && P0.shape(1) == p))
+    throw py::value_error("initial_covariance: expected a number or shape " + shape_of({p, p}) +
+                          ", got " + shape_string(P0));
+  require_finite(P0, "initial_covariance");
+  if (P0.ndim() == 0 && !(P0.data()[0] > 0.0))
+    throw py::value_error("initial_covariance: expected a value > 0, got " +
+                          std::string(py::str(py::float_(P0.data()[0]))));
+  if (theta0.is_none() && P0.ndim() == 0) {
+    rls.reset(P0.data()[0]);
+    return;
+  }
+  VectorX theta = VectorX::Zero(p);
+  if (!theta0.is_none())
+    theta = Eigen::Map<const VectorX>(parse_fixed(theta0, "theta0", {p}).data(), p);
+  const MatrixX P = P0.ndim() == 0 ? MatrixX(P0.data()[0] * MatrixX::Identity(p, p))
+                                   : MatrixX(block(P0.data(), p, p));
+  with_python_names([&] { rls.reset(theta, P); });
+}
+
+void set_max_variance(RLS& rls, py::handle value) {
+  if (value.is_none()) {
+    rls.set_max_variance(0.0);
+    return;
+  }
+  const double v = parse_number(value, "max_variance");
+  if (!std::isfinite(v) || !(v > 0.0))
+    throw py::value_error("max_variance: expected None or a finite number > 0, got " +
+                          std::string(py::str(py::float_(v))));
+  rls.set_max_variance(v);
+}
+
+py::array_t<double> copy_of(const VectorX& v) {
+  py::array_t<double> out(v.size());
+  std::memcpy(out.mutable_data(), v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
+  return out;
+}
+
+void update(RLS& rls, py::handle Y_obj, py::handle tau_obj) {
+  const int p = rls.p();
+  Array Y = as_real_array(Y_obj, "Y_k");
+  const bool ok =
+      (Y.ndim() == 1 && Y.shape(0) == p) || (Y.ndim() == 2 && Y.shape(1) == p && Y.shape(0) >= 1);
+  if (!ok)
+    throw py::value_error("Y_k: expected shape (m, " + std::to_string(p) + ") with m >= 1 or (" +
+                          std::to_string(p) + ",), got " + shape_string(Y));
+  const py::ssize_t m = Y.ndim() == 1 ? 1 : Y.shape(0);
+  Array tau = as_real_array(tau_obj, "tau_k");
+  if (!((tau.ndim() == 1 && tau.shape(0) == m) || (tau.ndim() == 0 && m == 1)))
+    throw py::value_error("tau_k: expected shape " + shape_of({m}) +
+                          (m == 1 ? " or a number" : "") + " to match Y_k " + shape_string(Y) +
+                          ", got " + shape_string(tau));
+  require_finite(Y, "Y_k");
+  require_finite(tau, "tau_k");
+  rls.update(block(Y.data(), m, p), Eigen::Map<const VectorX>(tau.data(), m));
+}
+
+// Y (T, m, p) or (T, p), tau (T, m) or (T,): every block is checked before the first update, so
+// that a bad sample leaves the estimator untouched.
+py::array update_batch(RLS& rls, py::handle Y_obj, py::handle tau_obj, py::handle history_obj) {
+  const bool history = parse_flag(history_obj, "history");
+  const int p = rls.p();
+  Array Y = as_real_array(Y_obj, "Y");
+  const bool ok =
+      (Y.ndim() == 3 && Y.shape(2) == p && Y.shape(1) >= 1) || (Y.ndim() == 2 && Y.shape(1) == p);
+  if (!ok)
+    throw py::value_error("Y: expected shape (T, m, " + std::to_string(p) +
+                          ") with m >= 1 or (T, " + std::to_string(p) + "), got " +
+                          shape_string(Y));
+  const py::ssize_t T = Y.shape(0);
+  const py::ssize_t m = Y.ndim() == 3 ? Y.shape(1) : 1;
+  Array tau = as_real_array(tau_obj, "tau");
+  const bool tau_ok = Y.ndim() == 3 ? (tau.ndim() == 2 && tau.shape(0) == T && tau.shape(1) == m)
+                                    : (tau.ndim() == 1 && tau.shape(0) == T);
+  if (!tau_ok)
+    throw py::value_error("tau: expected shape " +
+                          (Y.ndim() == 3 ? shape_of({T, m}) : shape_of({T})) + " to match Y " +
+                          shape_string(Y) + ", got " + shape_string(tau));
+  require_finite(Y, "Y");
+  require_finite(tau, "tau");
+
+  py::array_t<double> thetas(history ? std::vector<py::ssize_t>{T, p}
+                                     : std::vector<py::ssize_t>{p});
+  double* out = thetas.mutable_data();
+  const double* Y_data = Y.data();
+  const double* tau_data = tau.data();
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t t = 0; t < T; ++t) {
+      rls.update(block(Y_data + t * m * p, m, p), Eigen::Map<const VectorX>(tau_data + t * m, m));
+      if (history)
+        std::memcpy(out + t * p, rls.theta().data(), sizeof(double) * static_cast<std::size_t>(p));
+    }
+  }
+  if (!history) std::memcpy(out, rls.theta().data(), sizeof(double) * static_cast<std::size_t>(p));
+  return thetas;
+}
+
+constexpr const char* kClassDoc = R"doc(Recursive least squares with exponential forgetting (C++).
+
+Estimates theta in tau_k = Y_k theta one block at a time (one sample of an n-joint robot is a
+block of m = n rows of the base regressor). With forgetting factor lambda in (0, 1]:
+
+    K     = P Y_k^T (lambda I + Y_k P Y_k^T)^-1
+    theta = theta + K (tau_k - Y_k theta)
+    P     = (P - K Y_k P) / lambda
+
+P is kept in UD-factored form (Bierman), so it stays symmetric positive definite. With
+lambda = 1 and initial_covariance c the estimate equals the ridge-regularised batch solution
+(sum Y^T Y + I/c)^-1 (sum Y^T tau + theta0/c); with lambda < 1 old data fade as lambda^k.
+
+Parameters
+----------
+p : int
+    Number of parameters (columns of Y_k), >= 1.
+forgetting : float
+    lambda in (0, 1]; 1 keeps all data (stationary parameters).
+initial_covariance : float or (p, p) array
+    P_0: c * I for a number c > 0, or a symmetric positive definite matrix.
+theta0 : (p,) array, optional
+    Initial estimate (default zeros).
+max_variance : float, optional
+    With lambda < 1, cap on the UD variances against covariance windup when the data stop
+    exciting some direction; default the largest initial one (c for a number c).
+
+Not thread-safe: use one estimator per thread.)doc";
+
+}  // namespace
+
+void bind_recursive_least_squares(py::module_& m) {
+  py::class_<RLS>(m, "RecursiveLeastSquares", kClassDoc)
+      .def(py::init([](py::handle p, py::handle forgetting, py::handle initial_covariance,
+                       py::handle theta0, py::handle max_variance) {
+             // The core checks forgetting in (0, 1] (std::invalid_argument -> ValueError).
+             RLS rls(parse_count(p, "p"), parse_number(forgetting, "forgetting"));
+             set_initial_state(rls, initial_covariance, theta0);
+             set_max_variance(rls, max_variance);
+             return rls;
+           }),
+           py::arg("p"), py::arg("forgetting") = 1.0, py::arg("initial_covariance") = 1e6,
+           py::kw_only(), py::arg("theta0") = py::none(), py::arg("max_variance") = py::none())
+      .def("update", &update, py::arg("Y_k"), py::arg("tau_k"),
+           "One block: Y_k (m, p) or (p,) for m = 1, tau_k (m,) or a number for m = 1.")
+      .def("update_batch", &update_batch, py::arg("Y"), py::arg("tau"), py::arg("history") = false,
+           "Updates with T blocks in order, in C++ with the GIL released; exactly the same as "
+           "T calls of update(). Y (T, m, p) and tau (T, m), or Y (T, p) and tau (T,) for m = 1. "
+           "Returns the final theta (p,), or with history=True the estimate after each block "
+           "(T, p).")
+      .def(
+          "reset",
+          [](RLS& self, py::handle initial_covariance, py::handle theta0) {
+            if (initial_covariance.is_none() && theta0.is_none()) {
+              self.reset();
+              return;
+            }
+            set_initial_state(
+                self, initial_covariance.is_none() ? py::float_(1e6) : initial_covariance, theta0);
+          },
+          py::arg("initial_covariance") = py::none(), py::arg("theta0") = py::none(),
+          "Without arguments: back to the initial state of the constructor (or of the last reset "
+          "with arguments). Otherwise restart from a new initial state; a missing argument takes "
+          "its constructor default (1e6, zeros).")
+      .def_property_readonly("p", &RLS::p, "Number of parameters.")
+      .def_property_readonly(
+          "theta", [](const RLS& self) { return copy_of(self.theta()); },
+          "Current estimate (p,), a copy.")
+      .def_property_readonly(
+          "covariance",
+          [](const RLS& self) {
+            py::array_t<double> P({self.p(), self.p()});
+            self.covariance(
+                Eigen::Map<MatrixX>(P.mutable_data(), self.p(), self.p()));  // symmetric
+            return P;
+          },
+          "Current covariance P (p, p), exactly symmetric, a copy.")
+      .def_property(
+          "forgetting", &RLS::forgetting,
+          [](RLS& self, py::handle value) {
+            self.set_forgetting(parse_number(value, "forgetting"));
+          },
+          "Forgetting factor lambda in (0, 1]; may be changed between updates.")
+      .def_property(
+          "max_variance", &RLS::max_variance, &set_max_variance,
+          "Cap on the UD variances with forgetting < 1 (None sets the default, the largest "
+          "initial one).")
+      .def("__copy__", [](const RLS& self) { return RLS(self); })
+      .def(
+          "__deepcopy__", [](const RLS& self, py::handle) { return RLS(self); }, py::arg("memo"))
+      .def("__repr__", [](const RLS& self) {
+        return "RecursiveLeastSquares(p=" + std::to_string(self.p()) +
+               ", forgetting=" + std::string(py::str(py::float_(self.forgetting()))) + ")";
+      });
+}
+
+}  // namespace dynid::binding

@@ -1,0 +1,127 @@
+"""`dynid demo` end to end at small sizes (paper Sect. V-VI on the virtual LWR-IV).
+
+The demo's outputs are checked against independent facts: the true coefficients of the
+controller's model (beta @ pi), the 250 g tip, the paper's zero element M_76, the PNG file
+signature, and the JSON on disk against the returned report.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+
+import dynid
+import dynid.cli
+import numpy as np
+import pytest
+from dynid.demo import TIP_MASS, controller_model, run_demo
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+PLOTS = ("fig3_joint_motion.png", "fig4_torques.png", "fig6_g2_M11.png")
+
+
+def png_size(path) -> tuple[int, int]:
+    """Width and height from the IHDR chunk, after checking the signature."""
+    data = path.read_bytes()
+    assert data[:8] == PNG_SIGNATURE, path
+    assert data[12:16] == b"IHDR", path
+    return struct.unpack(">II", data[16:24])
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo") / "out"  # does not exist yet: the demo creates it
+    lines: list[str] = []
+    report = run_demo(out, train=60, validation=20, progress=lines.append)
+    return out, report, lines
+
+
+def test_demo_writes_json_matching_its_report(demo):
+    out, report, _ = demo
+    on_disk = json.loads((out / "demo.json").read_text())
+    assert on_disk == json.loads(json.dumps(report))
+    assert on_disk["settings"]["train"] == 60 and on_disk["settings"]["validation"] == 20
+    for key in ("coefficients", "zero_elements", "gravity_errors", "inertia_errors",
+                "condition_numbers", "payload", "plots"):
+        assert key in on_disk, key
+
+
+def test_demo_coefficients_are_the_true_ones_up_to_the_noise(demo):
+    # Demo noise: relative 1e-5 on g and M, 1e-5 rad on q. Against beta @ pi of the controller's
+    # model: within 1e-4 of the largest coefficient of each kind, and within 6 reported std + 1e-6
+    # relative each (6 sigma: 51 coefficients should never fail by chance).
+    out, _, _ = demo
+    coefficients = json.loads((out / "demo.json").read_text())["coefficients"]
+    truth = controller_model()
+    for kind in ("gravity", "inertia"):
+        base = dynid.base_parameters(truth, kind)
+        true = dict(zip(base.names, base.values(truth)))
+        rows = coefficients[kind]
+        assert [r["name"] for r in rows] == base.names
+        assert [r["expression"] for r in rows] == base.expressions
+        scale = max(abs(v) for v in true.values())
+        for r in rows:
+            error = abs(r["value"] - true[r["name"]])
+            assert error <= 1e-4 * scale, (kind, r)
+            assert error <= 6 * r["std"] + 1e-6 * scale, (kind, r)
+    assert len(coefficients["gravity"]) == 12  # paper: p_g = 12
+
+
+def test_demo_payload_estimates_are_near_250_g(demo):
+    # Only 60 configurations per arm here, yet the demo's noise (1e-5 relative) leaves ~0.05 %
+    # error: require 0.5 % (the brief's bound was 2 %; the paper-sized 1 % test is in
+    # test_payload.py).
+    _, report, _ = demo
+    payload = report["payload"]
+    assert payload["true_mass"] == TIP_MASS == 0.25
+    assert sorted(e["factor"] for e in payload["estimates"]) == [0.39, 0.4]
+    for e in payload["estimates"]:
+        assert e["mass"] == pytest.approx(0.25, rel=0.005), e
+
+
+def test_demo_reports_the_zero_element_and_the_tables(demo):
+    _, report, lines = demo
+    assert [(z["row"], z["column"]) for z in report["zero_elements"]] == [(6, 5)]
+    text = "\n".join(lines)
+    for k in range(1, 7):
+        assert f"[{k}/6]" in text  # progress of each step
+    assert "Table II" in text and "Table III" in text
+    assert "M[7,6]" in text and "Ixz7" in text and "Iyz7" in text
+    for name in ("TS", "VS", "TVE"):
+        errors = report["gravity_errors"][name]
+        assert len(errors["mse"]) == 7 and len(errors["max_abs"]) == 7
+        assert all(np.isfinite(errors["mse"])) and all(np.isfinite(errors["max_abs"]))
+    # Torque validation (eq. (33)): the identified model is exact up to the 1e-5 model noise, so
+    # the filtered tau_J and tau_hat differ by filtered sensor noise (0.05 N m at 1 kHz, 1 Hz
+    # cut-off: ~0.003 N m) and the ends of the numerical derivatives: below 0.05 N m.
+    assert max(report["gravity_errors"]["TVE"]["max_abs"]) < 0.05
+
+
+def test_demo_writes_three_png_plots(demo):
+    out, report, _ = demo
+    assert sorted(report["plots"]) == sorted(PLOTS)
+    for name in PLOTS:
+        path = out / name
+        assert path.stat().st_size > 10_000, name  # a real figure, not an empty canvas
+        width, height = png_size(path)
+        assert width > 300 and height > 300, (name, width, height)
+
+
+def test_cli_demo_returns_zero_and_writes_its_outputs(tmp_path, capsys):
+    out = tmp_path / "cli"
+    code = dynid.cli.main(
+        ["demo", "--output", str(out), "--train", "60", "--validation", "20", "--seed", "3"]
+    )
+    assert code == 0
+    printed = capsys.readouterr().out
+    assert "Table II" in printed and "m_tip" in printed
+    report = json.loads((out / "demo.json").read_text())
+    assert report["settings"]["seed"] == 3 and report["settings"]["train"] == 60
+    for name in PLOTS:
+        png_size(out / name)
+
+
+def test_cli_rejects_an_unknown_command(capsys):
+    with pytest.raises(SystemExit) as info:
+        dynid.cli.main(["nonsense"])
+    assert info.value.code != 0
