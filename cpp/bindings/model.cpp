@@ -332,7 +332,7 @@ void bind_model(py::module_& m) {
             const int P = regressor_columns(n, rotor, friction);
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
             return evaluate(self, s, {n, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat Y = row_major(out, n, P);
+              RowMajorMap Y(out, n, P);
               regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor, friction, Y);
             });
           },
@@ -344,7 +344,7 @@ void bind_model(py::module_& m) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
             return evaluate(self, s, {n, 10 * n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat Y = row_major(out, n, 10 * n);
+              RowMajorMap Y(out, n, 10 * n);
               gravity_regressor(m, ws, ConstVec(in[0], n), Y);
             });
           },
@@ -356,7 +356,7 @@ void bind_model(py::module_& m) {
             const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
             const Samples s = parse_samples({{q, "q"}}, n);
             return evaluate(self, s, {rows, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat Y = row_major(out, rows, P);
+              RowMajorMap Y(out, rows, P);
               inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
             });
           },

@@ -28,6 +28,7 @@ struct PyModel {
 using ConstVec = Eigen::Map<const VectorX>;
 using OutVec = Eigen::Map<VectorX>;
 using OutMat = Eigen::Map<MatrixX, 0, Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>>;
+using RowMajorMap = Eigen::Map<RowMajorMatrixX>;
 
 // A row-major block of the output array seen as an Eigen matrix.
 inline OutMat row_major(double* data, int rows, int cols) {

@@ -60,6 +60,7 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   // constant Tx(a_{i-1}) Rx(alpha_{i-1}) of the previous row precedes joint i, and link i's DH
   // frame sits at J_i * Tx(a_i) Rx(alpha_i).
   joints_.resize(n_);
+  offsets_.assign(n_, LinkOffset{});
   offset_R_.assign(n_, Matrix3::Identity());
   offset_p_.assign(n_, Vector3::Zero());
   for (int i = 0; i < n_; ++i) {
@@ -80,7 +81,8 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
     j.cos_alpha = std::cos(alpha);
     j.sin_alpha = std::sin(alpha);
     if (convention_ == Convention::Standard) {
-      offset_R_[i] = rotation_x(std::cos(r.alpha), std::sin(r.alpha));
+      offsets_[i] = LinkOffset{false, std::cos(r.alpha), std::sin(r.alpha), r.a};
+      offset_R_[i] = rotation_x(offsets_[i].cos_alpha, offsets_[i].sin_alpha);
       offset_p_[i] = Vector3(r.a, 0.0, 0.0);
     }
   }

@@ -12,6 +12,8 @@
 // zero: the block upper-triangular structure of the notes.
 #include "dynid/regressor.hpp"
 
+#include <algorithm>
+
 #include "dynid/kinematics.hpp"
 #include "dynid/rnea.hpp"
 
@@ -33,68 +35,114 @@ struct LinkMotion {
   Vector3 w, wd, a;
 };
 
-// Frame J_j -> DH frame j = J_j * (R, p) with (R, p) the model's link offset.
-inline Vector6 axis_in_link_frame(const Vector6& U, const Matrix3& R, const Vector3& p) {
-  Vector6 out;
-  out.head<3>() = R.transpose() * U.head<3>();
-  out.tail<3>() = R.transpose() * (U.tail<3>() + U.head<3>().cross(p));
-  return out;
-}
-
-inline LinkMotion motion_in_link_frame(const Workspace& ws, int j, const Matrix3& R,
-                                       const Vector3& p) {
+inline LinkMotion motion_in_link_frame(const Workspace& ws, int j, const LinkOffset& o) {
   const Vector3& w = ws.omega[j];
   const Vector3& wd = ws.omegad[j];
-  return {R.transpose() * w, R.transpose() * wd,
-          R.transpose() * (ws.a[j] + wd.cross(p) + w.cross(w.cross(p)))};
+  const Vector3 p(o.a, 0.0, 0.0);
+  return {o.rotate_to_link(w), o.rotate_to_link(wd),
+          o.rotate_to_link(ws.a[j] + wd.cross(p) + w.cross(w.cross(p)))};
 }
 
-// Y_ij of the header comment, written into row[0..9].
-inline void axis_row(const Vector6& U, const LinkMotion& k, double* row) {
-  const Vector3 s = U.head<3>(), l = U.tail<3>();
-  row[0] = l.dot(k.a);
-  const Vector3 h = l.cross(k.wd) + k.w * l.dot(k.w) - l * k.w.squaredNorm() + k.a.cross(s);
-  row[1] = h.x();
-  row[2] = h.y();
-  row[3] = h.z();
-  for (int c = 4; c < 10; ++c) row[c] = 0.0;
-  add_quadratic_form(s, k.wd, row + 4);
-  add_quadratic_form(s.cross(k.w), k.w, row + 4);
+// Link j's body regressor as a linear map of a joint axis [s; l] given in DH frame j: the closed
+// form of the header comment written as
+//   Y_ij = [ a . l,  W l + a x s,  G s ],  W = w w^T - |w|^2 E - wd^,  G = Q(wd) - Q(w) w^
+// where Q(v) u = K(u, v). W and G are formed once per link from the six products of w; the
+// n(n+1)/2 blocks are then plain scalar products (written out: Eigen's small fixed-size
+// expressions cost more here than the arithmetic itself).
+struct BodyMap {
+  double a[3], W[9], G[18];
+
+  explicit BodyMap(const LinkMotion& k) {
+    const Vector3& w = k.w;
+    const Vector3& wd = k.wd;
+    const double xx = w.x() * w.x(), yy = w.y() * w.y(), zz = w.z() * w.z();
+    const double xy = w.x() * w.y(), xz = w.x() * w.z(), yz = w.y() * w.z();
+    a[0] = k.a.x(), a[1] = k.a.y(), a[2] = k.a.z();
+    const double W_[9] = {-yy - zz,     xy + wd.z(), xz - wd.y(),  //
+                          xy - wd.z(),  -xx - zz,    yz + wd.x(),  //
+                          xz + wd.y(),  yz - wd.x(), -xx - yy};
+    // Q(wd) minus Q(w) w^, entry by entry.
+    const double G_[18] = {wd.x(),      xz,          -xy,          //
+                           wd.y() - xz, wd.x() + yz, xx - yy,      //
+                           wd.z() + xy, zz - xx,     wd.x() - yz,  //
+                           -yz,         wd.y(),      xy,           //
+                           yy - zz,     wd.z() - xy, wd.y() + xz,  //
+                           yz,          -xz,         wd.z()};
+    std::copy(W_, W_ + 9, W);
+    std::copy(G_, G_ + 18, G);
+  }
+
+  void row(const double* U, double* out) const {
+    const double s0 = U[0], s1 = U[1], s2 = U[2], l0 = U[3], l1 = U[4], l2 = U[5];
+    out[0] = a[0] * l0 + a[1] * l1 + a[2] * l2;
+    out[1] = W[0] * l0 + W[1] * l1 + W[2] * l2 + a[1] * s2 - a[2] * s1;
+    out[2] = W[3] * l0 + W[4] * l1 + W[5] * l2 + a[2] * s0 - a[0] * s2;
+    out[3] = W[6] * l0 + W[7] * l1 + W[8] * l2 + a[0] * s1 - a[1] * s0;
+    for (int r = 0; r < 6; ++r) out[4 + r] = G[3 * r] * s0 + G[3 * r + 1] * s1 + G[3 * r + 2] * s2;
+  }
+};
+
+// Joint axes are kept in the frames the link parameters are given in (DH frame j for standard
+// DH, J_j for modified DH), so that each 1 x 10 block reads them directly.
+//   modified: L_{j-1} -> L_j is the whole joint transform X[j];
+//   standard: F_{j-1} -> J_j is only Rz(theta_j) Tz(d_j) (X[j]'s constant part Rx Tx is link
+//             j-1's offset, already applied), then J_j -> F_j is link j's offset Tx(a_j) Rx(alpha_j).
+inline void axis_to_child(const JointTransform& X, Vector6& U) {
+  // Reference point to O_j (l + s x p), then R^T = Rz(-theta) Rx(-alpha) on both parts.
+  const Vector3 s = U.head<3>();
+  const Vector3 l = U.tail<3>() + s.cross(X.p);
+  U.head<3>() = X.rotate_to_child(s);
+  U.tail<3>() = X.rotate_to_child(l);
 }
 
-// Axis of joint j in its own frame J_j.
-inline Vector6 own_axis(const Model& model, int j) {
-  Vector6 U = Vector6::Zero();
-  U[model.joint(j - 1).revolute ? 2 : 5] = 1.0;
-  return U;
+inline void axis_through_joint_to_link(const JointTransform& X, const LinkOffset& o, Vector6& U) {
+  // F_{j-1} -> J_j: reference point to (0, 0, d), then Rz(-theta).
+  const double c = X.ct, sn = X.st;
+  const double l0 = U[3] + X.d * U[1], l1 = U[4] - X.d * U[0];
+  const double s0 = c * U[0] + sn * U[1], s1 = -sn * U[0] + c * U[1], s2 = U[2];
+  const double m0 = c * l0 + sn * l1, m1 = -sn * l0 + c * l1, m2 = U[5];
+  // J_j -> F_j: reference point to (a, 0, 0) (l + s x (a, 0, 0)), then Rx(-alpha).
+  const double ca = o.cos_alpha, sa = o.sin_alpha;
+  const double n1 = m1 + o.a * s2, n2 = m2 - o.a * s1;
+  U[0] = s0;
+  U[1] = ca * s1 + sa * s2;
+  U[2] = -sa * s1 + ca * s2;
+  U[3] = m0;
+  U[4] = ca * n1 + sa * n2;
+  U[5] = -sa * n1 + ca * n2;
 }
 
-// Motion vector in J_{j-1} -> J_j: move the reference point to O_j, then rotate.
-inline Vector6 axis_to_child(const JointTransform& X, const Vector6& U) {
+inline Vector6 axis_to_link(const LinkOffset& o, const Vector6& U) {
   Vector6 out;
-  out.head<3>() = X.rotate_to_child(U.head<3>());
-  out.tail<3>() = X.rotate_to_child(U.tail<3>() + U.head<3>().cross(X.p));
+  out << o.rotate_to_link(U.head<3>()),
+      o.rotate_to_link(Vector3(U[3], U[4] + o.a * U[2], U[5] - o.a * U[1]));
   return out;
+}
+
+// Moves the axes of joints 1..j-1 from link frame j-1 to link frame j and adds joint j's own.
+inline void advance_axes(const Model& model, Workspace& ws, int j) {
+  const LinkOffset& o = model.link_offset(j - 1);
+  Vector6 own = Vector6::Zero();
+  own[model.joint(j - 1).revolute ? 2 : 5] = 1.0;
+  if (o.identity) {
+    for (int i = 1; i < j; ++i) axis_to_child(ws.X[j], ws.axes[i]);
+    ws.axes[j] = own;
+  } else {
+    for (int i = 1; i < j; ++i) axis_through_joint_to_link(ws.X[j], o, ws.axes[i]);
+    ws.axes[j] = axis_to_link(o, own);
+  }
 }
 
 // Fills the 10n rigid-body columns from the current ws.X and ws.omega/omegad/a.
-void rigid_body_columns(const Model& model, Workspace& ws, MatrixOut Y) {
+void rigid_body_columns(const Model& model, Workspace& ws, RowMajorOut Y) {
   const int n = ws.n;
-  const bool offset = model.convention() == Convention::Standard;
-  double row[10];
+  for (int i = 1; i <= n; ++i) std::fill(&Y(i - 1, 0), &Y(i - 1, 0) + 10 * (i - 1), 0.0);
   for (int j = 1; j <= n; ++j) {
-    for (int i = 1; i < j; ++i) ws.axes[i] = axis_to_child(ws.X[j], ws.axes[i]);
-    ws.axes[j] = own_axis(model, j);
-    const Matrix3& R = model.link_offset_rotation(j - 1);
-    const Vector3& p = model.link_offset_translation(j - 1);
-    const LinkMotion k = offset ? motion_in_link_frame(ws, j, R, p)
-                                : LinkMotion{ws.omega[j], ws.omegad[j], ws.a[j]};
-    for (int i = 1; i <= j; ++i) {
-      axis_row(offset ? axis_in_link_frame(ws.axes[i], R, p) : ws.axes[i], k, row);
-      for (int c = 0; c < 10; ++c) Y(i - 1, 10 * (j - 1) + c) = row[c];
-    }
-    for (int i = j + 1; i <= n; ++i)
-      for (int c = 0; c < 10; ++c) Y(i - 1, 10 * (j - 1) + c) = 0.0;
+    advance_axes(model, ws, j);
+    const LinkOffset& o = model.link_offset(j - 1);
+    const BodyMap map(o.identity ? LinkMotion{ws.omega[j], ws.omegad[j], ws.a[j]}
+                                 : motion_in_link_frame(ws, j, o));
+    for (int i = 1; i <= j; ++i) map.row(ws.axes[i].data(), &Y(i - 1, 10 * (j - 1)));
   }
 }
 
@@ -105,7 +153,7 @@ int regressor_columns(int n, bool rotor, bool friction) {
 }
 
 void regressor(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-               const VectorIn& qdd, bool rotor, bool friction, MatrixOut Y) {
+               const VectorIn& qdd, bool rotor, bool friction, RowMajorOut Y) {
   const int n = ws.n;
   update_joint_transforms(model, ws, q);
   propagate_motion(model, ws, qd, qdd, -model.gravity_base());
@@ -125,41 +173,33 @@ void regressor(const Model& model, Workspace& ws, const VectorIn& q, const Vecto
   }
 }
 
-void gravity_regressor(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut Yg) {
+void gravity_regressor(const Model& model, Workspace& ws, const VectorIn& q, RowMajorOut Yg) {
   update_joint_transforms(model, ws, q);
   propagate_motion(model, ws, ws.zeros, ws.zeros, -model.gravity_base());
   rigid_body_columns(model, ws, Yg);
 }
 
 void inertia_regressor(const Model& model, Workspace& ws, const VectorIn& q, bool rotor,
-                       MatrixOut Ym) {
+                       RowMajorOut Ym) {
   // Column k of B is the torque for qdd = e_k at rest without gravity: link j >= k then has
   // wd = s_kj and a = l_kj (its joint-k axis), so entry (i, k) of link j's block is
   //   [ l_i . l_k,  l_i x s_k + l_k x s_i,  K(s_i, s_k) ]   (the body regressor with w = 0).
   const int n = ws.n;
   update_joint_transforms(model, ws, q);
-  const bool offset = model.convention() == Convention::Standard;
   Ym.setZero();
   for (int j = 1; j <= n; ++j) {
-    for (int i = 1; i < j; ++i) ws.axes[i] = axis_to_child(ws.X[j], ws.axes[i]);
-    ws.axes[j] = own_axis(model, j);
-    const Matrix3& R = model.link_offset_rotation(j - 1);
-    const Vector3& p = model.link_offset_translation(j - 1);
+    advance_axes(model, ws, j);
     for (int i = 1; i <= j; ++i) {
-      const Vector6 Ui = offset ? axis_in_link_frame(ws.axes[i], R, p) : ws.axes[i];
+      const Vector3 si = ws.axes[i].head<3>(), li = ws.axes[i].tail<3>();
       for (int k = 1; k <= i; ++k) {
-        const Vector6 Uk = offset ? axis_in_link_frame(ws.axes[k], R, p) : ws.axes[k];
-        const Vector3 si = Ui.head<3>(), li = Ui.tail<3>(), sk = Uk.head<3>(), lk = Uk.tail<3>();
-        const int r = (i - 1) * i / 2 + (k - 1);
-        const int c0 = 10 * (j - 1);
-        Ym(r, c0) = li.dot(lk);
+        const Vector3 sk = ws.axes[k].head<3>(), lk = ws.axes[k].tail<3>();
+        double* row = &Ym((i - 1) * i / 2 + (k - 1), 10 * (j - 1));
+        row[0] = li.dot(lk);
         const Vector3 h = li.cross(sk) + lk.cross(si);
-        Ym(r, c0 + 1) = h.x();
-        Ym(r, c0 + 2) = h.y();
-        Ym(r, c0 + 3) = h.z();
-        double quad[6] = {0, 0, 0, 0, 0, 0};
-        add_quadratic_form(si, sk, quad);
-        for (int c = 0; c < 6; ++c) Ym(r, c0 + 4 + c) = quad[c];
+        row[1] = h.x();
+        row[2] = h.y();
+        row[3] = h.z();
+        add_quadratic_form(si, sk, row + 4);
       }
     }
   }

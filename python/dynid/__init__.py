@@ -12,7 +12,10 @@ from .base_parameters import BaseParameters, base_parameters
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .io import Log, load_log, prepare_log, save_log
+from .log_identification import LogIdentification, identify_log, validate_log
+from .model_files import load_model, save_model
 from .recursive import RecursiveLeastSquares
+from .result_files import load_result
 from .robot import Robot
 from .sim import VirtualController
 
@@ -21,17 +24,23 @@ __all__ = [
     "IdentifiedModel",
     "LeastSquaresResult",
     "Log",
+    "LogIdentification",
     "RankDeficientError",
     "RecursiveLeastSquares",
     "Robot",
     "VirtualController",
     "base_parameters",
     "identify_from_controller",
+    "identify_log",
     "least_squares",
     "load_log",
+    "load_model",
+    "load_result",
     "models",
     "payload_mass_estimates",
     "prepare_log",
     "save_log",
+    "save_model",
+    "validate_log",
 ]
 __version__ = "0.1.0"

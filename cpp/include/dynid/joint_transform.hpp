@@ -16,6 +16,7 @@ namespace dynid {
 struct JointTransform {
   double ca = 1.0, sa = 0.0;  // cos/sin alpha (constant)
   double ct = 1.0, st = 0.0;  // cos/sin theta (joint dependent for revolute joints)
+  double d = 0.0;             // joint dependent for prismatic joints
   Vector3 p = Vector3::Zero();
 
   void set(double cos_alpha, double sin_alpha, double a, double theta, double d);
@@ -40,11 +41,12 @@ struct JointTransform {
 };
 
 inline void JointTransform::set(double cos_alpha, double sin_alpha, double a, double theta,
-                                double d) {
+                                double d_value) {
   ca = cos_alpha;
   sa = sin_alpha;
   ct = std::cos(theta);
   st = std::sin(theta);
+  d = d_value;
   p = Vector3(a, -sa * d, ca * d);
 }
 

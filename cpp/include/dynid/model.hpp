@@ -25,6 +25,18 @@ struct DHRow {
   JointType type = JointType::Revolute;
 };
 
+// DH frame i relative to joint frame J_i: Tx(a) Rx(alpha) (standard DH), identity (modified).
+struct LinkOffset {
+  bool identity = true;
+  double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
+
+  // Rx(alpha)^T x: a vector of J_i in the axes of DH frame i.
+  Vector3 rotate_to_link(const Vector3& x) const {
+    return Vector3(x.x(), cos_alpha * x.y() + sin_alpha * x.z(),
+                   -sin_alpha * x.y() + cos_alpha * x.z());
+  }
+};
+
 // Constant part of joint i in the modified form used by the algorithms (joint_transform.hpp).
 struct JointGeometry {
   double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
@@ -65,6 +77,7 @@ class Model {
   // Link i's parameters about the origin of its joint frame J_i.
   const RigidBodyParameters& body(int i) const { return bodies_[i]; }
   // DH frame i = J_i * link_offset(i): identity for modified DH, Tx(a_i) Rx(alpha_i) for standard.
+  const LinkOffset& link_offset(int i) const { return offsets_[i]; }
   const Matrix3& link_offset_rotation(int i) const { return offset_R_[i]; }
   const Vector3& link_offset_translation(int i) const { return offset_p_[i]; }
   // Gravity expressed in frame 0 (the base frame).
@@ -86,6 +99,7 @@ class Model {
 
   std::vector<JointGeometry> joints_;
   std::vector<RigidBodyParameters> bodies_;
+  std::vector<LinkOffset> offsets_;
   std::vector<Matrix3> offset_R_;
   std::vector<Vector3> offset_p_;
   Vector3 gravity_base_;

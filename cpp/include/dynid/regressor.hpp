@@ -13,14 +13,14 @@ int regressor_columns(int n, bool rotor, bool friction);
 // Y(q, qd, qdd) (n x P) with Y pi == rnea(q, qd, qdd). Block upper triangular: the row of joint i
 // has zeros in the columns of links j < i.
 void regressor(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-               const VectorIn& qdd, bool rotor, bool friction, MatrixOut Y);
+               const VectorIn& qdd, bool rotor, bool friction, RowMajorOut Y);
 
 // Y_g(q) (n x 10n) with Y_g pi == gravity(q).
-void gravity_regressor(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut Yg);
+void gravity_regressor(const Model& model, Workspace& ws, const VectorIn& q, RowMajorOut Yg);
 
 // Y_m(q) (n(n+1)/2 x 10n [+ n]) with Y_m pi == the lower triangle of B(q) [of M(q) with the rotor
 // columns], rows in np.tril_indices(n) order: (0,0), (1,0), (1,1), (2,0), ...
 void inertia_regressor(const Model& model, Workspace& ws, const VectorIn& q, bool rotor,
-                       MatrixOut Ym);
+                       RowMajorOut Ym);
 
 }  // namespace dynid

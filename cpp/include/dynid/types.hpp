@@ -19,6 +19,9 @@ using VectorIn = Eigen::Ref<const VectorX>;
 using VectorOut = Eigen::Ref<VectorX>;
 // Matrix outputs take any strides, so row-major NumPy blocks are written in place.
 using MatrixOut = Eigen::Ref<MatrixX, 0, Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>>;
+// Regressors are written row by row (one joint's row holds its 1 x 10 blocks contiguously).
+using RowMajorMatrixX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using RowMajorOut = Eigen::Ref<RowMajorMatrixX>;
 
 // S(v) of the notes: skew(v) * x == v.cross(x).
 inline Matrix3 skew(const Vector3& v) {

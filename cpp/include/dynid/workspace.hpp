@@ -43,7 +43,8 @@ struct Workspace {
   std::vector<Vector6> column_wrench, row_inertia;
   std::vector<Vector3> row_coriolis;
 
-  // Regressors: the joint axes i <= j as spatial motion vectors [s; l] in frame J_j.
+  // Regressors: the joint axes i <= j as spatial motion vectors [s; l] in the frame of link j's
+  // parameters.
   std::vector<Vector6> axes;
 
   // Forward dynamics and scratch.

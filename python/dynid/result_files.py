@@ -1,0 +1,231 @@
+"""Identification results on disk: ``result.json`` and the PNG plots of ``dynid identify``.
+
+``result.json`` holds everything needed to apply the model to another log with no other input:
+the model (DH table, joint types, convention, gravity, base/tool, limits), the regressor options,
+the base-parameter structure (independent columns and beta over the standard parameter names),
+the coefficients with their expressions and standard deviations, the condition number and rank,
+and the training log's preparation and per-joint fit. Non-finite numbers (a relative standard
+deviation of a coefficient that is exactly 0) are written as null.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .io import Log
+from .log_identification import LogIdentification
+from .model_files import dumps_json, model_from_dict
+from .plots import plot_residuals, plot_torques
+
+PathLike = Union[str, Path]
+
+FORMAT = "dynid-identification"
+VERSION = 1
+RESULT_FILE = "result.json"
+
+
+def save_result(result: LogIdentification, folder: PathLike, log: Log | None = None) -> Path:
+    """Write ``folder/result.json`` and, when ``log`` is given, the plots of the fit on it."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / RESULT_FILE
+    path.write_text(dumps_json(result_to_dict(result)) + "\n")
+    if log is not None:
+        save_plots(folder, log, result.predict(log), "training log")
+    return path
+
+
+def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str) -> list[Path]:
+    """``torques.png`` (measured and predicted torque per joint) and ``residuals.png``."""
+    t = log.t - log.t[0]
+    name = Path(log.source).name or what
+    return [
+        plot_torques(t, log.tau, predicted, folder / "torques.png",
+                     title=f"Measured and predicted joint torques ({what}: {name})"),
+        plot_residuals(t, predicted - log.tau, folder / "residuals.png",
+                       title=f"Torque residuals, predicted - measured ({what}: {name})"),
+    ]
+
+
+def load_result(path: PathLike) -> LogIdentification:
+    """Read a result folder (or its JSON file). FileNotFoundError when absent; ValueError naming
+    the file and the field that is missing or malformed."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / RESULT_FILE
+    if not path.is_file():
+        raise FileNotFoundError(f"result: no such file: {path}")
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON: {exc.msg} at line {exc.lineno}") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file") from None
+    try:
+        return result_from_dict(data)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+
+
+def result_to_dict(result: LogIdentification) -> dict[str, Any]:
+    """The content of ``result.json`` (JSON-ready)."""
+    coefficients = [
+        {"name": name, "value": _num(value), "std": _num(std), "relative_std_percent": _num(rel),
+         "expression": expr}
+        for name, value, std, rel, expr in zip(result.names, result.theta, result.std,
+                                               result.relative_std, result.expressions)
+    ]
+    training = dict(result.training)
+    training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "model": result.model,
+        "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
+                    "method": result.method, "exclude_joints": list(result.excluded)},
+        "condition_number": _num(result.condition_number),
+        "rank": result.rank,
+        "coefficients": coefficients,
+        "training": training,
+        "base_parameters": {
+            "count": result.count,
+            "parameter_names": result.parameter_names,
+            "independent": result.independent.tolist(),
+            "beta": _nums(result.beta),
+        },
+    }
+
+
+def result_from_dict(data: Any) -> LogIdentification:
+    """A LogIdentification from the content of ``result.json``."""
+    data = _object(data, "result")
+    if data.get("format") != FORMAT:
+        raise ValueError(f"format: expected {FORMAT!r} (a dynid identify result), got "
+                         f"{data.get('format')!r}")
+    model = _object(_get(data, "model"), "model")
+    try:
+        robot = model_from_dict(model)
+    except ValueError as exc:
+        raise ValueError(f"model: {exc}") from None
+    options = _object(_get(data, "options"), "options")
+    flags = {k: _get(options, k, "options") for k in ("rotor", "friction", "offset")}
+    for key, value in flags.items():
+        if not isinstance(value, bool):
+            raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+                f"options.{key}: expected true or false, got {value!r}"
+            )
+    base = _object(_get(data, "base_parameters"), "base_parameters")
+    names_std = _get(base, "parameter_names", "base_parameters")
+    expected = robot.parameter_names(flags["rotor"], flags["friction"])
+    if names_std != expected:
+        raise ValueError(
+            f"base_parameters.parameter_names: do not match the model's regressor columns "
+            f"({len(expected)} expected for rotor={flags['rotor']}, friction={flags['friction']})"
+        )
+    independent = _array(_get(base, "independent", "base_parameters"),
+                         "base_parameters.independent", 1).astype(np.int64)
+    count = independent.size
+    if np.any(independent < 0) or np.any(independent >= len(expected)):
+        raise ValueError("base_parameters.independent: column index out of range")
+    beta = _array(_get(base, "beta", "base_parameters"), "base_parameters.beta", 2)
+    if beta.shape != (count, len(expected)):
+        raise ValueError(f"base_parameters.beta: expected shape {(count, len(expected))}, "
+                         f"got {beta.shape}")
+    rows = _get(data, "coefficients")
+    p = count + (robot.n if flags["offset"] else 0)
+    if not isinstance(rows, list) or len(rows) != p:
+        raise ValueError(f"coefficients: expected a list of {p} entries")
+    records = [_object(row, f"coefficients[{k}]") for k, row in enumerate(rows)]
+    column = {
+        key: [_get(row, key, f"coefficients[{k}]") for k, row in enumerate(records)]
+        for key in ("name", "value", "std", "relative_std_percent", "expression")
+    }
+    training = _object(data.get("training", {}), "training")
+    metrics = _object(training.get("metrics", {}), "training.metrics")
+    training["metrics"] = {k: _array(v, f"training.metrics.{k}", 1, nullable=True)
+                           for k, v in metrics.items()}
+    method = _get(options, "method", "options")
+    return LogIdentification(
+        model=dict(model), rotor=flags["rotor"], friction=flags["friction"],
+        offset=flags["offset"], method=str(method), parameter_names=list(names_std),
+        independent=independent, beta=beta, names=[str(x) for x in column["name"]],
+        expressions=[str(x) for x in column["expression"]],
+        theta=_array(column["value"], "coefficients[].value", 1),
+        std=_array(column["std"], "coefficients[].std", 1, nullable=True),
+        relative_std=_array(column["relative_std_percent"],
+                            "coefficients[].relative_std_percent", 1, nullable=True),
+        condition_number=float(_array(_get(data, "condition_number"), "condition_number", 0,
+                                      nullable=True)),
+        rank=int(_array(_get(data, "rank"), "rank", 0)),
+        excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
+        training=training,
+        _robot=robot,
+    )
+
+
+def metrics_to_dict(metrics: dict[str, NDArray[np.float64]]) -> dict[str, list]:
+    """Per-joint metric arrays as JSON-ready lists (non-finite as null)."""
+    return {k: _nums(v) for k, v in metrics.items()}
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _num(value: Any) -> float | None:
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def _nums(value: Any) -> Any:
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 0:
+        return _num(array)
+    return [_nums(v) for v in array]
+
+
+def _object(value: Any, where: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+            f"{where}: expected an object, got {type(value).__name__}"
+        )
+    return dict(value)
+
+
+def _get(data: dict[str, Any], key: str, where: str = "") -> Any:
+    if key not in data:
+        raise ValueError(f"{where + '.' if where else ''}{key}: missing")
+    return data[key]
+
+
+def _array(value: Any, where: str, ndim: int, nullable: bool = False) -> NDArray[np.float64]:
+    """Numbers (nested lists) of ``ndim`` dimensions; null is inf where ``nullable``."""
+    if nullable:
+        value = _null_to_inf(value)
+    try:
+        if _has_bool(value):
+            raise TypeError
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: expected numbers, got {str(value)[:60]}") from None
+    if array.ndim != ndim:
+        raise ValueError(f"{where}: expected {ndim} dimension(s), got shape {array.shape}")
+    if not nullable and not np.all(np.isfinite(array)):
+        raise ValueError(f"{where}: contains null, NaN or inf")
+    return array
+
+
+def _null_to_inf(value: Any) -> Any:
+    if value is None:
+        return np.inf
+    return [_null_to_inf(v) for v in value] if isinstance(value, list) else value
+
+
+def _has_bool(value: Any) -> bool:
+    if isinstance(value, bool):
+        return True
+    return isinstance(value, list) and any(_has_bool(v) for v in value)

@@ -1,0 +1,109 @@
+"""`dynid identify`, `dynid validate`, `dynid info`: in process through main(), once as a process."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import dynid
+import numpy as np
+import pytest
+from dynid.cli import main
+from dynid.io import save_log
+from dynid.log_identification import load_result
+from dynid.model_files import save_model
+from test_log_identification import PNG, fourier_log
+
+
+def _arm() -> dynid.Robot:
+    robot = dynid.models.planar_2r()
+    robot.Fv = np.array([0.3, 0.2])
+    robot.Fs = np.array([0.4, 0.1])
+    return robot
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """A 2R arm's model file, a training log (NPZ) and a validation log (CSV), exact torques."""
+    folder = tmp_path_factory.mktemp("cli")
+    arm = _arm()
+    save_model(dynid.models.planar_2r(), folder / "arm.json")  # the structure only matters
+    save_log(fourier_log(arm, 1, seconds=4.0), folder / "train.npz")
+    save_log(fourier_log(arm, 2, seconds=2.0), folder / "check.csv")
+    np.savez(folder / "no_tau.npz", t=np.arange(3.0), q=np.zeros((3, 2)))
+    (folder / "no_rows.json").write_text(json.dumps({"convention": "standard"}))
+    return folder
+
+
+def test_identify_validate_and_info(files, tmp_path, capsys):
+    out, check = tmp_path / "ident", tmp_path / "check"
+    argv = ["identify", str(files / "train.npz"), "--model", str(files / "arm.json"),
+            "--friction", "--method", "ols", "--output", str(out)]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "[5/5] wrote" in printed and "condition number" in printed and "Fs2" in printed
+    arm = _arm()
+    expected = dynid.base_parameters(arm, friction=True).values(arm)
+    result = load_result(out)
+    np.testing.assert_allclose(result.theta, expected, rtol=0, atol=1e-9)
+    assert (out / "torques.png").read_bytes()[:8] == PNG
+
+    assert main(["validate", str(out), str(files / "check.csv"), "--output", str(check)]) == 0
+    printed = capsys.readouterr().out
+    assert "rel. rms" in printed and "J2" in printed
+    report = json.loads((check / "validation.json").read_text())
+    assert report["samples"] == 200
+    assert max(report["metrics"]["relative_rms"]) < 1e-9  # the exact model, again
+    assert all((check / name).read_bytes()[:8] == PNG for name in ("torques.png", "residuals.png"))
+
+    assert main(["info", "--model", str(files / "arm.json")]) == 0
+    printed = capsys.readouterr().out
+    assert "planar 2R: 2 joints (RR), standard DH" in printed
+    assert "base parameters: torque 6 (rigid body)" in printed  # SPEC §3: 6 in a vertical plane
+
+
+def test_preparation_options_reach_the_result(files, tmp_path, capsys):
+    argv = ["identify", str(files / "train.npz"), "--model", "planar_2r", "--friction",
+            "--skip", "10", "--cutoff", "8", "--order", "2", "--decimate", "2",
+            "--min-velocity", "0.01", "--outliers", "8", "--offset", "--output", str(tmp_path)]
+    assert main(argv) == 0
+    training = json.loads((tmp_path / "result.json").read_text())["training"]
+    assert training["preparation"] == {"cutoff": 8.0, "decimate": 2, "order": 2,
+                                       "min_velocity": 0.01, "outlier_k": 8.0}
+    notes = " ".join(training["notes"])
+    assert "skipped the first 10 samples" in notes and "order-2 Butterworth 8 Hz" in notes
+    assert "|qd| < 0.01" in notes
+    assert "prepared: skipped" not in capsys.readouterr().out  # step 3 lists the new notes only
+
+
+ERRORS = [
+    (["identify", "{d}/absent.npz"], "path: no such file"),
+    (["identify", "{d}/no_tau.npz"], "missing key 'tau'"),
+    (["identify", "{d}/train.npz", "--model", "{d}/no_rows.json"], "rows: missing"),
+    (["identify", "{d}/train.npz", "--model", "scara"], "neither a built-in model"),
+    (["identify", "{d}/train.npz", "--model", "kuka_lwr4"], "log: has 2 joints"),
+    (["identify", "{d}/train.npz", "--cutoff", "500"], "cutoff: expected 0 < cutoff"),
+    (["validate", "{d}/absent", "{d}/check.csv"], "result: no such file"),
+    (["validate", "{d}/arm.json", "{d}/check.csv"], "format: expected 'dynid-identification'"),
+    (["info", "--model", "{d}/no_rows.json"], "rows: missing"),
+]
+
+
+@pytest.mark.parametrize("argv, message", ERRORS)
+def test_errors_exit_2_with_one_line(files, capsys, argv, message):
+    assert main([a.format(d=files) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"dynid {argv[0]}: error: ")
+    assert message in err and "Traceback" not in err
+
+
+def test_as_a_process(files):
+    """The installed entry point: a bad input is one line on stderr and exit status 2."""
+    done = subprocess.run(
+        [sys.executable, "-m", "dynid.cli", "identify", str(files / "no_tau.npz")],
+        check=False, capture_output=True, text=True, timeout=120,
+    )
+    assert done.returncode == 2
+    assert done.stderr.startswith("dynid identify: error: ") and done.stderr.count("\n") == 1
+    assert "missing key 'tau'" in done.stderr and "Traceback" not in done.stderr
