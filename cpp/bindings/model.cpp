@@ -2,6 +2,7 @@
 // per-sample dynamics calls (single sample or a batch looped in C++).
 #include "model.hpp"
 
+#include <atomic>
 #include <cctype>
 #include <stdexcept>
 
@@ -69,7 +70,25 @@ py::object energy(PyModel& self, const Samples& s, py::array result) {
 
 }  // namespace
 
+namespace {
+std::atomic<int> g_batch_threads{1};
+}  // namespace
+
+int batch_threads() { return g_batch_threads.load(); }
+
+void set_batch_threads(int threads) {
+  if (threads < 1)
+    throw py::value_error("threads: expected a positive number of threads, got " +
+                          std::to_string(threads));
+  g_batch_threads.store(threads);
+}
+
 void bind_model(py::module_& m) {
+  m.def("set_threads", &set_batch_threads, py::arg("threads"),
+        "Use this many threads (each with its own workspace, GIL released) for batch calls of "
+        "at least 512 samples per thread. Default 1.");
+  m.def("get_threads", &batch_threads, "Threads used by batch calls.");
+
   py::class_<PyModel>(m, "Model")
       .def(py::init([](py::handle dh, const std::string& joint_types, const std::string& convention,
                        py::handle gravity, py::handle base, py::handle tool) {

@@ -3,7 +3,11 @@
 // workspace used by single-sample calls, which run with the GIL held.
 #pragma once
 
+#include <algorithm>
+#include <exception>
 #include <memory>
+#include <thread>
+#include <vector>
 
 #include "arrays.hpp"
 #include "dynid/dynid.hpp"
@@ -35,8 +39,17 @@ inline OutMat row_major(double* data, int rows, int cols) {
   return OutMat(data, rows, cols, Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>(1, cols));
 }
 
+// Worker threads for batch calls (dynid.set_threads); 1 by default.
+int batch_threads();
+void set_batch_threads(int threads);
+
+// Below this many samples per thread a batch runs on one thread: starting a thread costs about
+// as much as a few hundred samples.
+constexpr py::ssize_t kMinSamplesPerThread = 512;
+
 // Runs kernel(model, workspace, inputs, output) on one sample, or on each of T samples in C++
-// with the GIL released; the output has shape `tail` or (T, *tail).
+// with the GIL released, split over batch_threads() threads each with its own Workspace; the
+// output has shape `tail` or (T, *tail).
 template <class Kernel>
 py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail, Kernel kernel) {
   const int n = self.model->n();
@@ -45,21 +58,43 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   if (!s.single) tail.insert(tail.begin(), s.count);
   py::array_t<double> out(tail);
   double* out_data = out.mutable_data();
-  const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+  const std::size_t arguments = s.arrays.size();
   if (s.single) {
-    for (std::size_t k = 0; k < s.arrays.size(); ++k) in[k] = s.row(k, 0, n);
+    const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+    for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
     return out;
   }
   std::shared_ptr<const Model> model = self.model;
-  {
-    py::gil_scoped_release release;
+  auto run = [&](py::ssize_t begin, py::ssize_t end) {
     Workspace ws(*model);
-    for (py::ssize_t t = 0; t < s.count; ++t) {
-      for (std::size_t k = 0; k < s.arrays.size(); ++k) in[k] = s.row(k, t, n);
+    const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+    for (py::ssize_t t = begin; t < end; ++t) {
+      for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
       kernel(*model, ws, in, out_data + t * per_sample);
     }
+  };
+  const py::ssize_t threads = std::max<py::ssize_t>(
+      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
+  py::gil_scoped_release release;
+  if (threads == 1) {
+    run(0, s.count);
+    return out;
   }
+  std::vector<std::thread> pool;
+  std::vector<std::exception_ptr> errors(threads);
+  for (py::ssize_t k = 0; k < threads; ++k) {
+    pool.emplace_back([&, k] {
+      try {
+        run(s.count * k / threads, s.count * (k + 1) / threads);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    });
+  }
+  for (std::thread& worker : pool) worker.join();
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
   return out;
 }
 

@@ -8,6 +8,7 @@ checking the result (``validation``, ``plots``) and the command line (``cli``).
 """
 
 from . import models
+from ._core import get_threads, set_threads
 from .base_parameters import BaseParameters, base_parameters
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
@@ -30,6 +31,7 @@ __all__ = [
     "Robot",
     "VirtualController",
     "base_parameters",
+    "get_threads",
     "identify_from_controller",
     "identify_log",
     "least_squares",
@@ -41,6 +43,7 @@ __all__ = [
     "prepare_log",
     "save_log",
     "save_model",
+    "set_threads",
     "validate_log",
 ]
 __version__ = "0.1.0"
