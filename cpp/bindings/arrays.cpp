@@ -16,6 +16,8 @@ std::string shape_string(const py::array& a) {
 }
 
 Array as_real_array(py::handle obj, const char* name) {
+  // Fast path: already a C-contiguous float64 array (no conversion, no dtype inspection).
+  if (py::isinstance<Array>(obj)) return py::reinterpret_borrow<Array>(obj);
   py::array raw = py::array::ensure(obj);
   if (!raw) {
     throw py::value_error(std::string(name) + ": expected an array of real numbers, got " +
@@ -38,24 +40,32 @@ void require_finite(const Array& a, const char* name) {
   }
 }
 
-Samples parse_samples(const std::vector<std::pair<py::handle, const char*>>& args, int n) {
+Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> args, int n) {
   Samples s;
-  const std::string expected =
-      "expected shape (" + std::to_string(n) + ",) or (T, " + std::to_string(n) + ")";
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const char* name = args[k].second;
-    Array a = as_real_array(args[k].first, name);
+  const char* first_name = nullptr;
+  py::ssize_t first_ndim = 0;
+  for (const auto& [obj, name] : args) {
+    Array a = as_real_array(obj, name);
     const bool ok = (a.ndim() == 1 || a.ndim() == 2) && a.shape(a.ndim() - 1) == n;
-    if (!ok) throw py::value_error(std::string(name) + ": " + expected + ", got " + shape_string(a));
-    if (k == 0) {
+    if (!ok)
+      throw py::value_error(std::string(name) + ": expected shape (" + std::to_string(n) +
+                            ",) or (T, " + std::to_string(n) + "), got " + shape_string(a));
+    if (s.size == 0) {
+      first_name = name;
+      first_ndim = a.ndim();
       s.single = a.ndim() == 1;
       s.count = s.single ? 1 : a.shape(0);
-    } else if ((a.ndim() == 1) != s.single || (!s.single && a.shape(0) != s.count)) {
-      throw py::value_error(std::string(name) + ": expected shape " + shape_string(s.arrays[0]) +
-                            " like " + args[0].second + ", got " + shape_string(a));
+    } else if (a.ndim() != first_ndim || (!s.single && a.shape(0) != s.count)) {
+      const std::string expected =
+          s.single ? "(" + std::to_string(n) + ",)"
+                   : "(" + std::to_string(s.count) + ", " + std::to_string(n) + ")";
+      throw py::value_error(std::string(name) + ": expected shape " + expected + " like " +
+                            first_name + ", got " + shape_string(a));
     }
     require_finite(a, name);
-    s.arrays.push_back(std::move(a));
+    s.data[s.size] = a.data();
+    s.owners[s.size] = std::move(a);
+    ++s.size;
   }
   return s;
 }

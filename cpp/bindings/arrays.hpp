@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <initializer_list>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,17 +24,19 @@ Array as_real_array(py::handle obj, const char* name);
 // Raises ValueError when the array holds NaN or inf.
 void require_finite(const Array& a, const char* name);
 
-// One or several per-sample arguments (q, qd, ...): each (n,) for one sample or (T, n) for T.
+// One to three per-sample arguments (q, qd, ...): each (n,) for one sample or (T, n) for T.
+// Fixed-size storage: parsing a single sample allocates nothing beyond NumPy's own objects.
 struct Samples {
-  std::vector<Array> arrays;
+  static constexpr std::size_t kMaxArguments = 3;
+  py::object owners[kMaxArguments];  // keep converted arrays alive
+  const double* data[kMaxArguments] = {nullptr, nullptr, nullptr};
+  std::size_t size = 0;
   py::ssize_t count = 1;  // T
   bool single = true;
-  const double* row(std::size_t k, py::ssize_t t, int n) const {
-    return arrays[k].data() + t * n;
-  }
+  const double* row(std::size_t k, py::ssize_t t, int n) const { return data[k] + t * n; }
 };
 
-Samples parse_samples(const std::vector<std::pair<py::handle, const char*>>& args, int n);
+Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> args, int n);
 
 // A fixed-size array argument (e.g. gravity (3,), base (4, 4)).
 Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_t>& shape);

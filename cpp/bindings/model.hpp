@@ -58,7 +58,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   if (!s.single) tail.insert(tail.begin(), s.count);
   py::array_t<double> out(tail);
   double* out_data = out.mutable_data();
-  const std::size_t arguments = s.arrays.size();
+  const std::size_t arguments = s.size;
   if (s.single) {
     const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
     for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);

@@ -2,27 +2,72 @@
 // joint frames. Column i of B is the wrench that a unit acceleration of joint i demands from the
 // composite body of links i..n, carried inwards and projected on each joint axis (b_ij depends
 // only on links max(i,j)..n, notes "Dynamic parameters of robots 4").
+//
+// The composite inertias are moved to the parent frame with the DH structure of the joint
+// transform (R = Rx(alpha) Rz(theta)): two plane rotations of the six entries of a symmetric
+// tensor instead of a general R I R^T.
 #include "dynid/crba.hpp"
 
 #include "dynid/kinematics.hpp"
 
 namespace dynid {
+namespace {
+
+using Composite = Workspace::Composite;
+
+Composite from_body(const RigidBodyParameters& b) {
+  return {b.m, b.h, {b.I(0, 0), b.I(0, 1), b.I(0, 2), b.I(1, 1), b.I(1, 2), b.I(2, 2)}};
+}
+
+// The composite body of J_i seen from J_{i-1} (x_parent = R x + p), added to `parent`.
+void add_to_parent(const JointTransform& X, const Composite& c, Composite& parent) {
+  const double* I = c.I;  // xx, xy, xz, yy, yz, zz
+  // Rz(theta) I Rz^T
+  const double C = X.ct, S = X.st, CC = C * C, SS = S * S, CS = C * S;
+  const double xx = CC * I[0] - 2.0 * CS * I[1] + SS * I[3];
+  const double yy = SS * I[0] + 2.0 * CS * I[1] + CC * I[3];
+  const double xy = CS * (I[0] - I[3]) + (CC - SS) * I[1];
+  const double xz = C * I[2] - S * I[4];
+  const double yz = S * I[2] + C * I[4];
+  const double zz = I[5];
+  // Rx(alpha) (...) Rx^T
+  const double ca = X.ca, sa = X.sa, aa = ca * ca, bb = sa * sa, ab = ca * sa;
+  double R[6] = {xx,
+                 ca * xy - sa * xz,
+                 sa * xy + ca * xz,
+                 aa * yy - 2.0 * ab * yz + bb * zz,
+                 ab * (yy - zz) + (aa - bb) * yz,
+                 bb * yy + 2.0 * ab * yz + aa * zz};
+  // Shift to the parent origin (generalised Steiner, rigid_body.cpp):
+  // + 2 (p.hr) E - (hr p^T + p hr^T) + m (|p|^2 E - p p^T)
+  const Vector3 hr = X.rotate_to_parent(c.h);
+  const Vector3& p = X.p;
+  const double m = c.m;
+  const double k = 2.0 * p.dot(hr) + m * p.squaredNorm();
+  R[0] += k - 2.0 * hr.x() * p.x() - m * p.x() * p.x();
+  R[3] += k - 2.0 * hr.y() * p.y() - m * p.y() * p.y();
+  R[5] += k - 2.0 * hr.z() * p.z() - m * p.z() * p.z();
+  R[1] -= hr.x() * p.y() + p.x() * hr.y() + m * p.x() * p.y();
+  R[2] -= hr.x() * p.z() + p.x() * hr.z() + m * p.x() * p.z();
+  R[4] -= hr.y() * p.z() + p.y() * hr.z() + m * p.y() * p.z();
+  parent.m += m;
+  parent.h += hr + m * p;
+  for (int e = 0; e < 6; ++e) parent.I[e] += R[e];
+}
+
+}  // namespace
 
 void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B) {
   const int n = ws.n;
-  ws.composite[n] = model.body(n - 1);
-  for (int i = n - 1; i >= 1; --i) {
-    const JointTransform& X = ws.X[i + 1];
-    ws.composite[i] = ws.composite[i + 1].expressed_in_parent(X.rotation(), X.p);
-    ws.composite[i] += model.body(i - 1);
-  }
+  for (int i = 1; i <= n; ++i) ws.composite[i] = from_body(model.body(i - 1));
+  for (int i = n; i >= 2; --i) add_to_parent(ws.X[i], ws.composite[i], ws.composite[i - 1]);
 
   for (int i = 1; i <= n; ++i) {
-    const RigidBodyParameters& C = ws.composite[i];
+    const Composite& C = ws.composite[i];
     Vector3 f, mu;  // wrench about the origin of J_i for a unit acceleration along z
     if (model.joint(i - 1).revolute) {
-      mu = C.I.col(2);
-      f = Vector3(-C.h.y(), C.h.x(), 0.0);  // z x h
+      mu = Vector3(C.I[2], C.I[4], C.I[5]);  // I e_z
+      f = Vector3(-C.h.y(), C.h.x(), 0.0);   // z x h
     } else {
       mu = Vector3(C.h.y(), -C.h.x(), 0.0);  // h x z
       f = Vector3(0.0, 0.0, C.m);

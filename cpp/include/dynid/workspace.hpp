@@ -30,8 +30,14 @@ struct Workspace {
   std::vector<Matrix3> R_world;
   std::vector<Vector3> p_world;
 
-  // CRBA: composite bodies in the joint frames.
-  std::vector<RigidBodyParameters> composite;
+  // CRBA: composite bodies in the joint frames (mass, first moment, the six entries of the
+  // symmetric inertia xx, xy, xz, yy, yz, zz about the frame origin).
+  struct Composite {
+    double m;
+    Vector3 h;
+    double I[6];
+  };
+  std::vector<Composite> composite;
 
   // Coriolis matrix (coriolis_matrix.cpp): world-frame joint axes S_k, their derivatives, body
   // velocities, and per link the sums over the outboard links of the spatial inertias and of
