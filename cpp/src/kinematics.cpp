@@ -17,8 +17,15 @@ void update_world_frames(const Model& model, Workspace& ws) {
   ws.R_world[0] = model.base().topLeftCorner<3, 3>();
   ws.p_world[0] = model.base().topRightCorner<3, 1>();
   for (int i = 1; i <= ws.n; ++i) {
-    ws.p_world[i] = ws.p_world[i - 1] + ws.R_world[i - 1] * ws.X[i].p;
-    ws.R_world[i] = ws.R_world[i - 1] * ws.X[i].rotation();
+    const JointTransform& X = ws.X[i];
+    const Matrix3& P = ws.R_world[i - 1];
+    Matrix3& R = ws.R_world[i];
+    ws.p_world[i] = ws.p_world[i - 1] + P * X.p;
+    // R = P Rx(alpha) Rz(theta), as two plane rotations of P's columns.
+    const Vector3 c1 = X.ca * P.col(1) + X.sa * P.col(2);
+    R.col(2) = -X.sa * P.col(1) + X.ca * P.col(2);
+    R.col(0) = X.ct * P.col(0) + X.st * c1;
+    R.col(1) = -X.st * P.col(0) + X.ct * c1;
   }
 }
 

@@ -40,13 +40,21 @@ RigidBodyParameters RigidBodyParameters::expressed_in_parent(const Matrix3& R,
                                                              const Vector3& p) const {
   // Sum over mass points x_A = R x_B + p of m (|x|^2 E - x x^T), with hr = R h:
   // R I R^T + 2 (p . hr) E - hr p^T - p hr^T + m (|p|^2 E - p p^T).
+  // Written for the six independent entries (the result is symmetric by construction).
   RigidBodyParameters out;
   const Vector3 hr = R * h;
   out.m = m;
   out.h = hr + m * p;
-  const Matrix3 cross_terms = hr * p.transpose();
-  out.I = R * I * R.transpose() - cross_terms - cross_terms.transpose() +
-          (2.0 * p.dot(hr) + m * p.squaredNorm()) * Matrix3::Identity() - m * p * p.transpose();
+  const Matrix3 RI = R * I;
+  const double k = 2.0 * p.dot(hr) + m * p.squaredNorm();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = r; c < 3; ++c) {
+      double v = RI.row(r).dot(R.row(c)) - hr[r] * p[c] - p[r] * hr[c] - m * p[r] * p[c];
+      if (r == c) v += k;
+      out.I(r, c) = v;
+      out.I(c, r) = v;
+    }
+  }
   return out;
 }
 

@@ -10,6 +10,7 @@ checking the result (``validation``, ``plots``) and the command line (``cli``).
 from . import models
 from ._core import get_threads, set_threads
 from .base_parameters import BaseParameters, base_parameters
+from .cmake import get_cmake_dir, get_include
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .io import Log, load_log, prepare_log, save_log
@@ -31,6 +32,8 @@ __all__ = [
     "Robot",
     "VirtualController",
     "base_parameters",
+    "get_cmake_dir",
+    "get_include",
     "get_threads",
     "identify_from_controller",
     "identify_log",
