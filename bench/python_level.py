@@ -188,24 +188,31 @@ def batch(
     stats = time_interleaved(loops, runs, T)
     result["dynid"] = stats[0]
     result["pinocchio"] = stats[1] if pin is not None else None
-    result["threads"] = None  # filled by batch_threaded when dynid takes threads=
+    result["threads"] = None  # filled by batch_threaded (dynid.set_threads)
     return result
 
 
 def batch_threaded(
     robot: Any, Q: Array, Qd: Array, Qdd: Array, runs: int, threads: int
 ) -> dict[str, Any] | None:
-    """dynid's batch rnea with ``threads=threads`` (time per state [us]), checked against the
-    default call; None when this dynid's batch calls take no ``threads=`` argument."""
-    try:
-        threaded = robot.rnea(Q, Qd, Qdd, threads=threads)
-    except TypeError:
+    """dynid's batch rnea on ``threads`` threads (``dynid.set_threads``), time per state [us],
+    checked against the single-thread call; None when this dynid has no thread setting."""
+    import dynid
+
+    if not hasattr(dynid, "set_threads"):
         return None
-    _require_agreement(
-        {"threaded batch rnea": _worst(threaded, robot.rnea(Q, Qd, Qdd))},
-        "dynid threaded vs default batch",
-    )
-    stat = time_interleaved([lambda: robot.rnea(Q, Qd, Qdd, threads=threads)], runs, len(Q))[0]
+    previous = dynid.get_threads()
+    try:
+        dynid.set_threads(1)
+        single = robot.rnea(Q, Qd, Qdd)
+        dynid.set_threads(threads)
+        _require_agreement(
+            {"threaded batch rnea": _worst(robot.rnea(Q, Qd, Qdd), single)},
+            "dynid threaded vs single-thread batch",
+        )
+        stat = time_interleaved([lambda: robot.rnea(Q, Qd, Qdd)], runs, len(Q))[0]
+    finally:
+        dynid.set_threads(previous)
     return {"count": threads, "dynid": stat}
 
 

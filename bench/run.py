@@ -84,7 +84,7 @@ def parse_args() -> argparse.Namespace:
         "--threads",
         type=int,
         default=os.cpu_count() or 1,
-        help="also time dynid's batch with threads=N if it supports it",
+        help="also time dynid's batch rnea on N threads (dynid.set_threads)",
     )
     parser.add_argument(
         "--cpu",

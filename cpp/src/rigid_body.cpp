@@ -45,11 +45,16 @@ RigidBodyParameters RigidBodyParameters::expressed_in_parent(const Matrix3& R,
   const Vector3 hr = R * h;
   out.m = m;
   out.h = hr + m * p;
-  const Matrix3 RI = R * I;
   const double k = 2.0 * p.dot(hr) + m * p.squaredNorm();
+  // Scalar loops over the symmetric entries: cheaper than Eigen's general 3x3 products here.
+  double RI[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      RI[r][c] = R(r, 0) * I(0, c) + R(r, 1) * I(1, c) + R(r, 2) * I(2, c);
   for (int r = 0; r < 3; ++r) {
     for (int c = r; c < 3; ++c) {
-      double v = RI.row(r).dot(R.row(c)) - hr[r] * p[c] - p[r] * hr[c] - m * p[r] * p[c];
+      double v = RI[r][0] * R(c, 0) + RI[r][1] * R(c, 1) + RI[r][2] * R(c, 2) - hr[r] * p[c] -
+                 p[r] * hr[c] - m * p[r] * p[c];
       if (r == c) v += k;
       out.I(r, c) = v;
       out.I(c, r) = v;
