@@ -11,6 +11,7 @@ from . import models
 from ._core import get_threads, set_threads
 from .base_parameters import BaseParameters, base_parameters
 from .cmake import get_cmake_dir, get_include
+from .excitation import FourierTrajectory, optimize_excitation
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .io import Log, load_log, prepare_log, save_log
@@ -23,6 +24,7 @@ from .sim import VirtualController
 
 __all__ = [
     "BaseParameters",
+    "FourierTrajectory",
     "IdentifiedModel",
     "LeastSquaresResult",
     "Log",
@@ -42,6 +44,7 @@ __all__ = [
     "load_model",
     "load_result",
     "models",
+    "optimize_excitation",
     "payload_mass_estimates",
     "prepare_log",
     "save_log",
