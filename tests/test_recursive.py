@@ -523,6 +523,7 @@ def test_update_makes_no_heap_allocation(tmp_path, record_property):
             "-DNDEBUG",
             "-std=c++17",
             f"-I{REPO / 'cpp' / 'include'}",
+            f"-I{REPO / 'cpp' / 'examples'}",  # allocation_counter.hpp
             f"-I{find_eigen()}",
             str(REPO / "tests" / "cpp" / "test_rls_no_allocation.cpp"),
             str(REPO / "cpp" / "src" / "recursive_least_squares.cpp"),

@@ -26,7 +26,7 @@ from .base_parameters import (
     linear_expression,
     round_significant,
 )
-from .identify import LeastSquaresResult, RankDeficientError, least_squares
+from .identify import LeastSquaresResult, RankDeficientError, least_squares, relative_std
 from .robot import Robot
 
 #: An element of M counts as identically zero when |M_ij| <= this * max|M| in every sample.
@@ -282,10 +282,9 @@ def _expand(
     theta = null_space @ reduced.theta
     covariance = null_space @ reduced.covariance @ null_space.T
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        relative = np.where(theta != 0.0, 100.0 * std / np.abs(theta), np.inf)
     return replace(
-        reduced, theta=theta, std=std, relative_std=relative, covariance=covariance, names=names
+        reduced, theta=theta, std=std, relative_std=relative_std(theta, std),
+        covariance=covariance, names=names,
     )
 
 

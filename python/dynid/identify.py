@@ -35,6 +35,12 @@ VARIANCE_FLOOR = 1e-6
 IDENTIFIABLE_TOLERANCE = 1e-8
 
 
+def relative_std(theta: NDArray[np.float64], std: NDArray[np.float64]) -> NDArray[np.float64]:
+    """100 std / |theta| in percent; inf where theta is exactly zero."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(theta != 0, 100.0 * std / np.abs(theta), np.inf)
+
+
 class RankDeficientError(ValueError):
     """The data do not excite all base parameters: the stacked regressor has rank < p."""
 
@@ -209,8 +215,7 @@ def least_squares(
         covariance[free, :] = np.inf
         covariance[:, free] = np.inf
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        relative = np.where(theta != 0, 100.0 * std / np.abs(theta), np.inf)
+    relative = relative_std(theta, std)
     return LeastSquaresResult(
         theta=theta,
         std=std,
