@@ -77,6 +77,19 @@ def _axis(x: NDArray, axis: int, name: str = "x") -> int:
     return int(axis) % x.ndim
 
 
+def _per_column(value: ArrayLike, name: str, columns: int, what: str) -> NDArray[np.float64]:
+    """A non-negative scalar or one value per column, as an array."""
+    array = _array(value, name, min_ndim=0)
+    if array.ndim > 1 or (array.ndim == 1 and array.size != columns):
+        raise ValueError(
+            f"{name}: expected a scalar or one value per {what} ({columns},), "
+            f"got shape {array.shape}"
+        )
+    if (array < 0).any():
+        raise ValueError(f"{name}: expected values >= 0, got {array}")
+    return array
+
+
 def _sosfiltfilt(
     x: NDArray, sos: NDArray, axis: int, order: int, name: str, padtype: str = "odd",
     padlen: int | None = None,
@@ -311,14 +324,7 @@ def moving_mask_min_velocity(
     if qd.ndim > 2:
         raise ValueError(f"qd: expected shape (T, n) or (T,), got {qd.shape}")
     columns = qd.reshape(qd.shape[0], -1)
-    thr = _array(threshold, "threshold", min_ndim=0)
-    if thr.ndim > 1 or (thr.ndim == 1 and thr.size != columns.shape[1]):
-        raise ValueError(
-            f"threshold: expected a scalar or one value per joint ({columns.shape[1]},), "
-            f"got shape {thr.shape}"
-        )
-    if (thr < 0).any():
-        raise ValueError(f"threshold: expected values >= 0, got {thr}")
+    thr = _per_column(threshold, "threshold", columns.shape[1], "joint")
     mask = np.abs(columns) >= thr
     if per_joint:
         return mask if qd.ndim == 2 else mask[:, 0]
@@ -353,14 +359,7 @@ def outlier_mask(
         raise ValueError(f"residual: expected shape (T, n) or (T,), got {r.shape}")
     k = _positive(k, "k")
     columns = r.reshape(r.shape[0], -1)
-    floor = _array(min_sigma, "min_sigma", min_ndim=0)
-    if floor.ndim > 1 or (floor.ndim == 1 and floor.size != columns.shape[1]):
-        raise ValueError(
-            f"min_sigma: expected a scalar or one value per column ({columns.shape[1]},), "
-            f"got shape {floor.shape}"
-        )
-    if (floor < 0).any():
-        raise ValueError(f"min_sigma: expected values >= 0, got {floor}")
+    floor = _per_column(min_sigma, "min_sigma", columns.shape[1], "column")
     deviation = np.abs(columns - np.median(columns, axis=0))
     sigma = MAD_TO_SIGMA * np.median(deviation, axis=0)
     fallback = np.sqrt(np.pi / 2) * deviation.mean(axis=0)
