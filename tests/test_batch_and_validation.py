@@ -37,6 +37,9 @@ CALLS: dict[str, tuple[tuple[str, ...], Callable[[int], tuple[int, ...]]]] = {
     "potential_energy": (("q",), lambda n: ()),
     "fkine": (("q",), lambda n: (4, 4)),
     "jacobian": (("q",), lambda n: (6, n)),
+    "regressor": (("q", "qd", "qdd"), lambda n: (n, 10 * n)),
+    "gravity_regressor": (("q",), lambda n: (n, 10 * n)),
+    "inertia_regressor": (("q",), lambda n: (n * (n + 1) // 2, 10 * n)),
 }
 # derandomized (same examples every run, no flakiness) and no example database on disk
 HYPOTHESIS = settings(
@@ -443,6 +446,28 @@ def test_hypothesis_dynamics_calls(call: str, data: st.DataObject) -> None:
     else:  # single and batch mixed (not documented): ValueError, or a result if the T agree
         same_t = len({a.shape[0] for a in arrays_ if a.ndim == 2}) == 1
         check_outcome(call_it, None if same_t else False, None)
+
+
+@pytest.mark.parametrize("call", sorted(CALLS))
+@HYPOTHESIS
+@given(data=st.data())
+def test_hypothesis_huge_finite_values(call: str, data: st.DataObject) -> None:
+    # Finite but enormous inputs (up to 1e300) overflow the arithmetic: the call must then raise
+    # a ValueError naming its inputs, never return inf or NaN (SPEC section 2).
+    names, out_shape = CALLS[call]
+    r = robot()
+    n = r.n
+    t = data.draw(st.sampled_from([None, 2]), label="batch")
+    shape = (n,) if t is None else (t, n)
+    huge = st.floats(-1e300, 1e300, allow_nan=False, allow_infinity=False)
+    args = [data.draw(arrays(np.float64, shape, elements=huge), label=k) for k in names]
+    try:
+        out = np.asarray(getattr(r, call)(*args), dtype=float)
+    except ValueError as error:
+        assert any(name in str(error) for name in names), str(error)
+        return
+    assert np.all(np.isfinite(out)), "non-finite result"
+    assert out.shape == (out_shape(n) if t is None else (t, *out_shape(n)))
 
 
 def link_is_physical(mass: float, com: np.ndarray, inertia: np.ndarray) -> bool | None:

@@ -19,6 +19,8 @@ def test_threaded_batches_equal_single_thread(two_threads):
     rng = np.random.default_rng(7)
     q, qd, qdd = rng.uniform(-1.0, 1.0, (3, 3000, robot.n))  # enough for two workers
     dynid.set_threads(2)
+    robot.rnea(q, qd, qdd)
+    assert dynid._core._last_batch_threads() == 2  # the batch really was split
     threaded = {
         "rnea": robot.rnea(q, qd, qdd),
         "mass_matrix": robot.mass_matrix(q),

@@ -1,6 +1,7 @@
 #include "arrays.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace dynid::binding {
@@ -63,11 +64,61 @@ Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> 
                             first_name + ", got " + shape_string(a));
     }
     require_finite(a, name);
+    if (s.size) s.names += ", ";
+    s.names += name;
     s.data[s.size] = a.data();
     s.owners[s.size] = std::move(a);
     ++s.size;
   }
   return s;
+}
+
+// The dtype kind of a scalar argument ('i', 'u', 'f', 'b', ...), '\0' when it is not a scalar;
+// NumPy scalars and 0-d arrays count as scalars.
+namespace {
+char scalar_kind(py::handle obj) {
+  py::array a = py::array::ensure(obj);
+  if (!a) PyErr_Clear();
+  return a && a.ndim() == 0 ? a.dtype().kind() : '\0';
+}
+}  // namespace
+
+int parse_count(py::handle obj, const char* name) {
+  const char kind = scalar_kind(obj);
+  if (kind != 'i' && kind != 'u')
+    throw py::value_error(std::string(name) + ": expected an integer, got " +
+                          std::string(py::repr(obj)));
+  const py::int_ value(py::reinterpret_borrow<py::object>(obj));  // __index__
+  if (value < py::int_(1))
+    throw py::value_error(std::string(name) + ": expected an integer >= 1, got " +
+                          std::string(py::repr(obj)));
+  if (value > py::int_(std::numeric_limits<int>::max()))
+    throw py::value_error(std::string(name) + ": too large, got " + std::string(py::repr(obj)));
+  return value.cast<int>();
+}
+
+double parse_number(py::handle obj, const char* name) {
+  const char kind = scalar_kind(obj);
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::value_error(std::string(name) + ": expected a number, got " +
+                          std::string(py::repr(obj)));
+  return py::float_(py::reinterpret_borrow<py::object>(obj)).cast<double>();
+}
+
+bool parse_flag(py::handle obj, const char* name) {
+  if (scalar_kind(obj) != 'b')
+    throw py::value_error(std::string(name) + ": expected True or False, got " +
+                          std::string(py::repr(obj)));
+  return PyObject_IsTrue(obj.ptr()) == 1;
+}
+
+void require_finite_result(const double* data, py::ssize_t n, const char* names) {
+  for (py::ssize_t k = 0; k < n; ++k) {
+    if (!std::isfinite(data[k]))
+      throw py::value_error(std::string(names) +
+                            ": the result overflowed to inf/NaN (inputs or parameters too large "
+                            "for double precision arithmetic)");
+  }
 }
 
 Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_t>& shape) {

@@ -30,6 +30,7 @@ struct Samples {
   static constexpr std::size_t kMaxArguments = 3;
   py::object owners[kMaxArguments];  // keep converted arrays alive
   const double* data[kMaxArguments] = {nullptr, nullptr, nullptr};
+  std::string names;  // "q, qd, qdd": for errors about the result
   std::size_t size = 0;
   py::ssize_t count = 1;  // T
   bool single = true;
@@ -37,6 +38,16 @@ struct Samples {
 };
 
 Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> args, int n);
+
+// Scalars with the type checks of SPEC section 2 (a wrong type is a ValueError naming the
+// argument, not pybind11's TypeError). NumPy scalars and 0-d arrays count as scalars.
+int parse_count(py::handle obj, const char* name);     // an integer >= 1
+double parse_number(py::handle obj, const char* name);  // a real number
+bool parse_flag(py::handle obj, const char* name);      // True or False
+
+// Raises ValueError naming `names` when the n values at `data` are not all finite: an overflow
+// from inputs (or parameters) too large for the arithmetic, never returned as NaN.
+void require_finite_result(const double* data, py::ssize_t n, const char* names);
 
 // A fixed-size array argument (e.g. gravity (3,), base (4, 4)).
 Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_t>& shape);

@@ -74,20 +74,23 @@ namespace {
 std::atomic<int> g_batch_threads{1};
 }  // namespace
 
+std::atomic<int> last_batch_threads{0};
+
 int batch_threads() { return g_batch_threads.load(); }
 
-void set_batch_threads(int threads) {
-  if (threads < 1)
-    throw py::value_error("threads: expected a positive number of threads, got " +
-                          std::to_string(threads));
-  g_batch_threads.store(threads);
-}
+void set_batch_threads(int threads) { g_batch_threads.store(threads); }
 
 void bind_model(py::module_& m) {
-  m.def("set_threads", &set_batch_threads, py::arg("threads"),
+  m.def(
+      "set_threads",
+      [](py::handle threads) { set_batch_threads(parse_count(threads, "threads")); },
+      py::arg("threads"),
         "Use this many threads (each with its own workspace, GIL released) for batch calls of "
         "at least 512 samples per thread. Default 1.");
   m.def("get_threads", &batch_threads, "Threads used by batch calls.");
+  m.def(
+      "_last_batch_threads", [] { return last_batch_threads.load(); },
+      "Threads the last batch call ran on.");
 
   py::class_<PyModel>(m, "Model")
       .def(py::init([](py::handle dh, const std::string& joint_types, const std::string& convention,
@@ -213,6 +216,9 @@ void bind_model(py::module_& m) {
       .def(
           "_link_inconsistency",
           [](const PyModel& self, int i) {
+            if (i < 0 || i >= self.model->n())
+              throw py::value_error("i: expected a link index in [0, " + std::to_string(self.model->n()) +
+                                    "), got " + std::to_string(i));
             const RigidBodyParameters b = RigidBodyParameters::from_standard(
                 Eigen::Matrix<double, 1, 10>(self.model->parameters().row(i)).data());
             if (!(b.m > 0.0)) return physical_inconsistency(b.m, Matrix3::Identity());
@@ -346,7 +352,10 @@ void bind_model(py::module_& m) {
           py::arg("q"), "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
       .def(
           "regressor",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, bool rotor, bool friction) {
+          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle rotor_flag,
+             py::handle friction_flag) {
+            const bool rotor = parse_flag(rotor_flag, "rotor");
+            const bool friction = parse_flag(friction_flag, "friction");
             const int n = self.model->n();
             const int P = regressor_columns(n, rotor, friction);
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
@@ -370,7 +379,8 @@ void bind_model(py::module_& m) {
           py::arg("q"), "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
       .def(
           "inertia_regressor",
-          [](PyModel& self, py::handle q, bool rotor) {
+          [](PyModel& self, py::handle q, py::handle rotor_flag) {
+            const bool rotor = parse_flag(rotor_flag, "rotor");
             const int n = self.model->n();
             const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
             const Samples s = parse_samples({{q, "q"}}, n);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <memory>
 #include <thread>
@@ -42,6 +43,8 @@ inline OutMat row_major(double* data, int rows, int cols) {
 // Worker threads for batch calls (dynid.set_threads); 1 by default.
 int batch_threads();
 void set_batch_threads(int threads);
+// Threads the last batch call ran on (for tests of the splitting).
+extern std::atomic<int> last_batch_threads;
 
 // Below this many samples per thread a batch runs on one thread: starting a thread costs about
 // as much as a few hundred samples.
@@ -63,6 +66,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
     const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
     for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
+    require_finite_result(out_data, per_sample, s.names.c_str());
     return out;
   }
   std::shared_ptr<const Model> model = self.model;
@@ -77,8 +81,10 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   const py::ssize_t threads = std::max<py::ssize_t>(
       1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
   py::gil_scoped_release release;
+  last_batch_threads = static_cast<int>(threads);
   if (threads == 1) {
     run(0, s.count);
+    require_finite_result(out_data, s.count * per_sample, s.names.c_str());
     return out;
   }
   std::vector<std::thread> pool;
@@ -95,6 +101,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   for (std::thread& worker : pool) worker.join();
   for (const std::exception_ptr& error : errors)
     if (error) std::rethrow_exception(error);
+  require_finite_result(out_data, s.count * per_sample, s.names.c_str());
   return out;
 }
 

@@ -30,43 +30,6 @@ std::string shape_of(std::initializer_list<py::ssize_t> dims) {
   return s + (dims.size() == 1 ? ",)" : ")");
 }
 
-// SPEC section 2: a wrong type is a ValueError naming the argument too, not pybind11's TypeError.
-// The dtype kind of a scalar argument ('i', 'u', 'f', 'b', ...), '\0' when it is not a scalar;
-// NumPy scalars and 0-d arrays count as scalars.
-char scalar_kind(py::handle obj) {
-  py::array a = py::array::ensure(obj);
-  if (!a) PyErr_Clear();
-  return a && a.ndim() == 0 ? a.dtype().kind() : '\0';
-}
-
-int parse_count(py::handle obj, const char* name) {
-  const char kind = scalar_kind(obj);
-  if (kind != 'i' && kind != 'u')
-    throw py::value_error(std::string(name) + ": expected an integer, got " +
-                          std::string(py::repr(obj)));
-  const py::int_ value(py::reinterpret_borrow<py::object>(obj));  // __index__
-  if (value < py::int_(1))
-    throw py::value_error(std::string(name) + ": expected an integer >= 1, got " +
-                          std::string(py::repr(obj)));
-  if (value > py::int_(std::numeric_limits<int>::max()))
-    throw py::value_error(std::string(name) + ": too large, got " + std::string(py::repr(obj)));
-  return value.cast<int>();
-}
-
-double parse_number(py::handle obj, const char* name) {
-  const char kind = scalar_kind(obj);
-  if (kind != 'f' && kind != 'i' && kind != 'u')
-    throw py::value_error(std::string(name) + ": expected a number, got " +
-                          std::string(py::repr(obj)));
-  return py::float_(py::reinterpret_borrow<py::object>(obj)).cast<double>();
-}
-
-bool parse_flag(py::handle obj, const char* name) {
-  if (scalar_kind(obj) != 'b')
-    throw py::value_error(std::string(name) + ": expected True or False, got " +
-                          std::string(py::repr(obj)));
-  return PyObject_IsTrue(obj.ptr()) == 1;
-}
 
 // The core names the C++ arguments (P0); the Python user passed initial_covariance.
 template <class Call>
@@ -116,6 +79,15 @@ void set_max_variance(RLS& rls, py::handle value) {
   rls.set_max_variance(v);
 }
 
+// An update whose numbers overflow double precision (|Y|, |tau| near 1e150 and beyond) leaves
+// inf/NaN in the estimate: say so instead of returning it.
+void require_finite_estimate(const RLS& rls, const char* names) {
+  if (!rls.theta().allFinite())
+    throw py::value_error(std::string(names) +
+                          ": the update overflowed (values too large for double precision); the "
+                          "estimate is lost, call reset()");
+}
+
 py::array_t<double> copy_of(const VectorX& v) {
   py::array_t<double> out(v.size());
   std::memcpy(out.mutable_data(), v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
@@ -139,6 +111,7 @@ void update(RLS& rls, py::handle Y_obj, py::handle tau_obj) {
   require_finite(Y, "Y_k");
   require_finite(tau, "tau_k");
   rls.update(block(Y.data(), m, p), Eigen::Map<const VectorX>(tau.data(), m));
+  require_finite_estimate(rls, "Y_k, tau_k");
 }
 
 // Y (T, m, p) or (T, p), tau (T, m) or (T,): every block is checked before the first update, so
@@ -178,6 +151,7 @@ py::array update_batch(RLS& rls, py::handle Y_obj, py::handle tau_obj, py::handl
         std::memcpy(out + t * p, rls.theta().data(), sizeof(double) * static_cast<std::size_t>(p));
     }
   }
+  require_finite_estimate(rls, "Y, tau");
   if (!history) std::memcpy(out, rls.theta().data(), sizeof(double) * static_cast<std::size_t>(p));
   return thetas;
 }

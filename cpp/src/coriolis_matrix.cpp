@@ -25,7 +25,7 @@ void coriolis_matrix(const Model& model, Workspace& ws, const VectorIn& q, const
   Vector3 w = Vector3::Zero(), u = Vector3::Zero();  // body velocity [w; u] about the world origin
   for (int i = 1; i <= n; ++i) {
     const Vector3 z = ws.R_world[i].col(2);
-    Vector6& Si = ws.S[i];
+    Vector6& Si = ws.axis_world[i];
     if (model.joint(i - 1).revolute)
       Si << z, ws.p_world[i].cross(z);
     else
@@ -33,7 +33,7 @@ void coriolis_matrix(const Model& model, Workspace& ws, const VectorIn& q, const
     w += Si.head<3>() * qd[i - 1];
     u += Si.tail<3>() * qd[i - 1];
     // Sdot = v x S (motion cross product).
-    ws.Sdot[i] << w.cross(Si.head<3>()), w.cross(Si.tail<3>()) + u.cross(Si.head<3>());
+    ws.axis_world_dot[i] << w.cross(Si.head<3>()), w.cross(Si.tail<3>()) + u.cross(Si.head<3>());
 
     const RigidBodyParameters b =
         model.body(i - 1).expressed_in_parent(ws.R_world[i], ws.p_world[i]);
@@ -60,20 +60,20 @@ void coriolis_matrix(const Model& model, Workspace& ws, const VectorIn& q, const
     return out;
   };
   for (int i = 1; i <= n; ++i) {
-    const Vector3 s = ws.S[i].head<3>(), l = ws.S[i].tail<3>();
+    const Vector3 s = ws.axis_world[i].head<3>(), l = ws.axis_world[i].tail<3>();
     // Column k = i: (B_sum S_k + I_sum Sdot_k), dotted with S_j for j <= k.
-    ws.column_wrench[i] = inertia_times(ws.inertia_sum[i], ws.Sdot[i]);
+    ws.column_wrench[i] = inertia_times(ws.inertia_sum[i], ws.axis_world_dot[i]);
     ws.column_wrench[i].head<3>() += ws.coriolis_block_sum[i] * s;
     ws.column_wrench[i].tail<3>() -= ws.momentum_sum[i].cross(s);
     // Row j = i for k < j: S_j^T B_sum S_k = (T^T s_j + f_sum x l_j) . s_k, S_j^T I_sum Sdot_k.
     ws.row_coriolis[i] = ws.coriolis_block_sum[i].transpose() * s + ws.momentum_sum[i].cross(l);
-    ws.row_inertia[i] = inertia_times(ws.inertia_sum[i], ws.S[i]);
+    ws.row_inertia[i] = inertia_times(ws.inertia_sum[i], ws.axis_world[i]);
   }
   for (int j = 1; j <= n; ++j) {
     for (int k = 1; k <= n; ++k) {
-      S(j - 1, k - 1) = j <= k ? ws.S[j].dot(ws.column_wrench[k])
-                               : ws.row_coriolis[j].dot(ws.S[k].head<3>()) +
-                                     ws.row_inertia[j].dot(ws.Sdot[k]);
+      S(j - 1, k - 1) = j <= k ? ws.axis_world[j].dot(ws.column_wrench[k])
+                               : ws.row_coriolis[j].dot(ws.axis_world[k].head<3>()) +
+                                     ws.row_inertia[j].dot(ws.axis_world_dot[k]);
     }
   }
 }

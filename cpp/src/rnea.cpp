@@ -3,18 +3,10 @@
 // of robots 3"). Joint i acts along z of J_i; X[i] maps J_i to J_{i-1}.
 #include "dynid/rnea.hpp"
 
+#include "dynid/friction.hpp"
 #include "dynid/kinematics.hpp"
 
 namespace dynid {
-namespace {
-
-double friction_torque(const Model& model, int i, double qd) {
-  const double sign = (qd > 0.0) - (qd < 0.0);
-  return model.viscous_friction()[i] * qd + model.coulomb_friction()[i] * sign;
-}
-
-}  // namespace
-
 void propagate_motion(const Model& model, Workspace& ws, const VectorIn& qd, const VectorIn& qdd,
                       const Vector3& base_acceleration) {
   const Vector3 z = Vector3::UnitZ();
@@ -66,10 +58,6 @@ void accumulate_wrenches(const Model& model, Workspace& ws, VectorOut tau) {
   }
 }
 
-void friction(const Model& model, const VectorIn& qd, VectorOut tau) {
-  for (int i = 0; i < model.n(); ++i) tau[i] = friction_torque(model, i, qd[i]);
-}
-
 void rnea(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
           const VectorIn& qdd, VectorOut tau) {
   update_joint_transforms(model, ws, q);
@@ -78,10 +66,5 @@ void rnea(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& 
   for (int i = 0; i < ws.n; ++i) tau[i] += Ia[i] * qdd[i] + friction_torque(model, i, qd[i]);
 }
 
-void coriolis(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-              VectorOut c) {
-  update_joint_transforms(model, ws, q);
-  newton_euler(model, ws, qd, ws.zeros, Vector3::Zero(), c);
-}
 
 }  // namespace dynid

@@ -27,6 +27,20 @@ class Robot(_core.Model):
     ``jacobian``) accept one sample (n,) or T samples (T, n).
     """
 
+    def __init__(
+        self,
+        dh: ArrayLike,
+        joint_types: str,
+        convention: str = "standard",
+        gravity: ArrayLike = (0.0, 0.0, -9.81),
+        base: ArrayLike | None = None,
+        tool: ArrayLike | None = None,
+    ) -> None:
+        super().__init__(dh, joint_types, convention, gravity, base, tool)
+        self._qlim = _default_limits(self.joint_types)
+        self._qlim.setflags(write=False)
+        self.name = f"{self.n}-dof arm"
+
     @classmethod
     def from_dh(
         cls,
@@ -77,8 +91,10 @@ class Robot(_core.Model):
         robot = cls(dh, joint_types.upper(), convention, gravity, base, tool)
         if params is not None:
             robot.params = params
-        robot.qlim = _default_limits(robot.joint_types) if qlim is None else qlim
-        robot.name = name or f"{n}-dof arm"
+        if qlim is not None:
+            robot.qlim = qlim
+        if name:
+            robot.name = name
         return robot
 
     # ---- limits and labels -------------------------------------------------------------------
@@ -113,8 +129,8 @@ class Robot(_core.Model):
         triangle inequalities.
         """
         valid_index = isinstance(i, (int, np.integer)) and not isinstance(i, (bool, np.bool_))
-        if not valid_index:
-            raise ValueError(f"i: expected an integer link index, got {i!r}")
+        if not valid_index or not 0 <= i < self.n:
+            raise ValueError(f"i: expected an integer link index in [0, {self.n}), got {i!r}")
         try:
             mass_value = float(mass)
         except (TypeError, ValueError):
@@ -129,6 +145,8 @@ class Robot(_core.Model):
     def parameter_vector(self, rotor: bool = False, friction: bool = False) -> NDArray[np.float64]:
         """The parameter vector pi matching the regressor's columns: the 10n standard parameters,
         then Ia (n) if ``rotor``, then Fv (n) and Fs (n) if ``friction``."""
+        _flag(rotor, "rotor")
+        _flag(friction, "friction")
         parts = [self.params.reshape(-1)]
         if rotor:
             parts.append(self.Ia)
@@ -138,6 +156,8 @@ class Robot(_core.Model):
 
     def parameter_names(self, rotor: bool = False, friction: bool = False) -> list[str]:
         """Names of :meth:`parameter_vector`'s entries: m1, mx1, ..., Izz_n, Ia1.., Fv1.., Fs1.."""
+        _flag(rotor, "rotor")
+        _flag(friction, "friction")
         links = range(1, self.n + 1)
         names = [f"{field}{i}" for i in links for field in PARAMETER_FIELDS]
         if rotor:
@@ -190,9 +210,18 @@ class Robot(_core.Model):
 
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
+        if isinstance(count, (bool, np.bool_)) or not isinstance(count, (int, np.integer)) or count < 0:
+            raise ValueError(f"count: expected a number of configurations >= 0, got {count!r}")
         rng = np.random.default_rng(seed)
         low, high = self.qlim[:, 0], self.qlim[:, 1]
         return low + (high - low) * rng.random((count, self.n))
+
+
+def _flag(value: object, name: str) -> None:
+    # SPEC section 2: a wrong type is a ValueError naming the argument as well.
+    if isinstance(value, (bool, np.bool_)):
+        return
+    raise ValueError(f"{name}: expected True or False, got {value!r}")
 
 
 def _text(value: object, name: str, expected: str) -> str:

@@ -26,11 +26,5 @@ void propagate_motion(const Model& model, Workspace& ws, const VectorIn& qd, con
 // the origin of J_i) to its parent's, from link n inwards, and projects it on the joint axis.
 void accumulate_wrenches(const Model& model, Workspace& ws, VectorOut tau);
 
-// c(q, qd): Coriolis and centrifugal torques (links only; rotors spin about fixed axes).
-void coriolis(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-              VectorOut c);
-
-// Fv qd + Fs sign(qd), sign(0) = 0.
-void friction(const Model& model, const VectorIn& qd, VectorOut tau);
 
 }  // namespace dynid

@@ -39,10 +39,10 @@ struct Workspace {
   };
   std::vector<Composite> composite;
 
-  // Coriolis matrix (coriolis_matrix.cpp): world-frame joint axes S_k, their derivatives, body
-  // velocities, and per link the sums over the outboard links of the spatial inertias and of
-  // the Coriolis factors' non-zero blocks (a 3x3 block and a momentum vector).
-  std::vector<Vector6> S, Sdot, body_velocity;
+  // Coriolis matrix (coriolis_matrix.cpp): world-frame joint axes (motion subspaces) and their
+  // time derivatives, and per link the sums over the outboard links of the spatial inertias and
+  // of the Coriolis factors' non-zero blocks (a 3x3 block and a momentum vector).
+  std::vector<Vector6> axis_world, axis_world_dot;
   std::vector<RigidBodyParameters> inertia_sum;
   std::vector<Matrix3> coriolis_block_sum;
   std::vector<Vector3> momentum_sum;
