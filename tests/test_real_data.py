@@ -28,7 +28,11 @@ SKIP = 500
 OPTIONS = {"rotor": True, "friction": True, "offset": True, "method": "wls"}
 
 #: What the correct pipeline scores on measurements_2 (relative RMS error per joint, fraction),
-#: and the bounds of the test: about 1.3 times that.
+#: and the bounds of the test: about 1.3 times that. EXPECTED is only a regression guard
+#: (rtol 0.05 below): the BOUNDS are the test. A tighter pin (it was rtol 2e-3) fails on any
+#: legitimate numerical change — another LAPACK, a different but equivalent scaling or
+#: factorisation in the least squares, a reordered sum — while a 5 % change of a validation
+#: error is already a real change of the fit worth looking at.
 EXPECTED = np.array([0.1483, 0.00862, 0.0741, 0.0207, 0.2189, 0.2976, 0.2165])
 BOUNDS = np.array([0.19, 0.011, 0.096, 0.027, 0.28, 0.38, 0.28])
 
@@ -61,7 +65,7 @@ def worst(relative_rms: np.ndarray) -> float:
 def test_correct_pipeline_meets_the_bounds_with_margin(correct):
     result, metrics = correct
     assert result.count == 62 and result.rank == 69  # 62 base parameters + 7 offsets
-    np.testing.assert_allclose(metrics["relative_rms"], EXPECTED, rtol=2e-3)
+    np.testing.assert_allclose(metrics["relative_rms"], EXPECTED, rtol=0.05)  # guard, see EXPECTED
     assert worst(metrics["relative_rms"]) < 0.8
     assert worst(result.training["metrics"]["relative_rms"]) < 0.8
     # FloBaRoID's "NRMS": the mean over joints of RMS error / (2 x torque limit), in percent;

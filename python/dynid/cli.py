@@ -12,11 +12,12 @@ from typing import Any
 
 import numpy as np
 
-from .demo import run_demo
+from .demo import check_demo_sizes, run_demo  # noqa: F401  (check_demo_sizes: public here too)
 
 #: Exit status for bad input (missing file, malformed log, model or result), as argparse's.
 EXIT_BAD_INPUT = 2
 DEFAULT_MODEL = "kuka_lwr4"
+
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -29,13 +30,11 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--train", type=int, default=1000, help="training configurations")
     demo.add_argument("--validation", type=int, default=200, help="validation configurations")
     demo.add_argument("--seed", type=int, default=0)
+    demo.set_defaults(run=_demo)
     _add_identify(commands)
     _add_validate(commands)
     _add_info(commands)
     args = parser.parse_args(argv)
-    if args.command == "demo":
-        run_demo(args.output, train=args.train, validation=args.validation, seed=args.seed)
-        return 0
     try:
         args.run(args)
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly
@@ -135,6 +134,10 @@ def _steps(total: int) -> Callable[[str], None]:
         print(f"[{count[0]}/{total}] {text}  ({time.perf_counter() - start:.1f} s)", flush=True)
 
     return step
+
+
+def _demo(args: argparse.Namespace) -> None:
+    run_demo(args.output, train=args.train, validation=args.validation, seed=args.seed)
 
 
 def _identify(args: argparse.Namespace) -> None:

@@ -21,15 +21,36 @@ from pathlib import Path
 import numpy as np
 
 from . import models, plots
+from ._checks import count
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .robot import Robot
 from .signal import differentiate, lowpass
 from .sim import VirtualController, paper_validation_trajectory
 from .validation import error_metrics, paper_table
 
+#: Fewest training configurations `dynid demo` accepts. The LWR-IV's 12 gravity coefficients are
+#: fitted on 6 rows per configuration (joint 1's gravity row is left out), so 2 configurations
+#: determine them exactly and a third leaves residual degrees of freedom for the noise estimate
+#: (the 39 inertia coefficients get 28 rows per configuration and are covered by then).
+DEMO_MIN_TRAIN = 3
+#: Fewest validation configurations: the errors need at least one sample.
+DEMO_MIN_VALIDATION = 1
+
 TIP_MASS = 0.25  # kg, the paper's symmetric steel tip
 TIP_COM = (0.0, 0.0, 0.11)  # m in frame 7 (at the wrist centre): flange plus half the tip
 TIP_INERTIA = np.diag([1.5e-4, 1.5e-4, 2.0e-5])  # kg m^2 about its centre: a 9 cm steel rod
+
+
+def check_demo_sizes(train: object, validation: object) -> tuple[int, int]:
+    """The demo's configuration counts, checked (``ValueError`` naming the argument)."""
+    train = count(
+        train, "train", DEMO_MIN_TRAIN,
+        "the LWR-IV's 12 gravity coefficients get 6 rows per configuration; 3 configurations "
+        "leave degrees of freedom for the noise estimate",
+    )
+    validation = count(validation, "validation", DEMO_MIN_VALIDATION,
+                       "the validation errors need at least one configuration")
+    return train, validation
 
 
 def controller_model() -> Robot:
@@ -54,6 +75,7 @@ def run_demo(
     progress: Callable[[str], None] = print,
 ) -> dict:
     """Run the demo, write JSON and PNGs into ``output`` and return the JSON content."""
+    train, validation = check_demo_sizes(train, validation)
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
+from ._checks import real_array
 from .base_parameters import BaseParameters, base_parameters
 from .robot import Robot
 
@@ -596,13 +597,7 @@ def _check_initial(
 
 # ---- argument checks (SPEC section 2: ValueError naming the argument) ----------------------------
 def _finite_array(value: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected numbers, got {value!r}") from None
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name}: expected finite values, got {value!r}")
-    return array
+    return real_array(value, name).copy()  # a copy: FourierTrajectory freezes its arrays
 
 
 def _finite_positive(value: object, name: str) -> float:

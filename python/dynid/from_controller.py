@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._checks import real_array
 from .base_parameters import (
     BaseParameters,
     base_parameters,
@@ -183,10 +184,14 @@ def payload_mass_estimates(
     coefficient gives an estimate m_L = (after - before) / k. The factors come from the base
     parameter expressions (for the LWR: d1 in pi_g(12), d2 in pi_g(7)), not from fixed indices.
     """
-    before = np.asarray(before, dtype=float)
-    after = np.asarray(after, dtype=float)
-    if before.shape != (base.count,) or after.shape != (base.count,):
-        raise ValueError(f"before, after: expected shape ({base.count},) each")
+    before = real_array(before, "before")
+    after = real_array(after, "after")
+    for name, value in (("before", before), ("after", after)):
+        if value.shape != (base.count,):
+            raise ValueError(
+                f"{name}: expected shape ({base.count},) (one value per base coefficient), "
+                f"got {value.shape}"
+            )
     last = base.parameter_names.index(f"m{_link_count(base)}")
     link_columns = slice(last, last + 10)
     estimates = []
@@ -212,16 +217,11 @@ def _link_count(base: BaseParameters) -> int:
 
 
 def _samples(value: ArrayLike, name: str, shape: tuple[int, ...]) -> NDArray[np.float64]:
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected an array of real numbers") from None
+    array = real_array(value, name)
     if array.ndim == len(shape):
         array = array[None]
     if array.shape[1:] != shape or array.shape[0] < 1:
         raise ValueError(f"{name}: expected shape (N, {', '.join(map(str, shape))}), got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name}: contains NaN or inf")
     return array
 
 

@@ -22,6 +22,8 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
+from ._checks import real_array
+
 METHODS = ("ols", "wls")
 ON_RANK_DEFICIENT = ("raise", "warn")
 
@@ -67,7 +69,14 @@ class LeastSquaresResult:
         Y = _finite(Y, "Y")
         if Y.ndim == 0 or Y.shape[-1] != self.theta.size:
             raise ValueError(f"Y: expected shape (..., {self.theta.size}), got {Y.shape}")
-        return Y @ self.theta
+        with np.errstate(over="ignore", invalid="ignore"):
+            tau = Y @ self.theta
+        if not np.all(np.isfinite(tau)):
+            raise ValueError(
+                f"Y: the predicted torque Y @ theta overflows float64 (max |Y| "
+                f"{np.abs(Y).max():.3g}, max |theta| {np.abs(self.theta).max():.3g})"
+            )
+        return tau
 
     def table(self) -> str:
         """An aligned text table: name, value, standard deviation, relative std in percent."""
@@ -167,6 +176,12 @@ def least_squares(
         )
     joints, member = np.unique(group, return_inverse=True)
     counts = np.bincount(member)
+    # Solve in units where max |A| and max |b| are in [0.5, 1): squares and norms of values near
+    # the float64 limits (~1e154 and up) would overflow, tiny ones underflow. Powers of two
+    # scale exactly, and everything is scaled back at the end.
+    a_exp, b_exp = _exponent(A), _exponent(b)
+    sizes = f"max |Y| {np.abs(A).max():.3g}, max |tau| {np.abs(b).max():.3g}"
+    A, b = np.ldexp(A, -a_exp), np.ldexp(b, -b_exp)
 
     def check_rank(rank: int, null: NDArray[np.float64], previous: int) -> None:
         if rank < min(p, previous):  # warn once per drop (WLS re-checks its weighted matrix)
@@ -214,7 +229,15 @@ def least_squares(
         covariance = covariance.copy()
         covariance[free, :] = np.inf
         covariance[:, free] = np.inf
-    std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    residual_rms = np.sqrt(np.bincount(member, weights=residual**2) / counts)
+    # Back to the units given: theta scales by 2^(b_exp - a_exp), the variances by its square.
+    std = np.sqrt(np.maximum(np.diag(covariance), 0.0))  # before its square can underflow
+    theta = _unscale(theta, b_exp - a_exp, "Y, tau", "the estimate theta ~ tau / Y", sizes)
+    std = _unscale(std, b_exp - a_exp, "Y, tau", "the standard deviation of theta", sizes)
+    covariance = _unscale(covariance, 2 * (b_exp - a_exp), "Y, tau", "the covariance of theta",
+                          sizes)
+    variance = _unscale(variance, 2 * b_exp, "tau", "the noise variance", sizes)
+    residual_rms = _unscale(residual_rms, b_exp, "tau", "the residual RMS", sizes)
     relative = relative_std(theta, std)
     return LeastSquaresResult(
         theta=theta,
@@ -225,7 +248,7 @@ def least_squares(
         rank=rank,
         method=method,
         noise_variance=variance,
-        residual_rms=np.sqrt(np.bincount(member, weights=residual**2) / counts),
+        residual_rms=residual_rms,
         names=names,
         excluded=excluded,
         joints=tuple(int(j) for j in joints),
@@ -241,7 +264,11 @@ def _svd_solve(
     column norms, so that A D^-1 = (Q U) S V^T. Over the r singular values above
     tolerance * s_max: theta = D^-1 V_r S_r^-1 U_r^T Q^T b, (A^T A)^+ = D^-1 V_r S_r^-2 V_r^T D^-1.
     """
-    scale = np.linalg.norm(A, axis=0)
+    # Column norms computed on columns divided by their largest entry: no overflow or underflow
+    # of the squares whatever the magnitudes.
+    peak = np.abs(A).max(axis=0)
+    peak[peak == 0] = 1.0
+    scale = peak * np.linalg.norm(A / peak, axis=0)
     scale[scale == 0] = 1.0  # an all-zero column keeps a zero singular value
     Q, R = scipy.linalg.qr(A, mode="economic")
     U, s, Vt = scipy.linalg.svd(R / scale, lapack_driver="gesvd")
@@ -252,6 +279,25 @@ def _svd_solve(
     unscaled = scipy.linalg.svdvals(R)  # the singular values of A
     cond = float(unscaled[0] / unscaled[-1]) if unscaled[-1] > 0 else np.inf
     return theta, unit_cov, rank, Vt[rank:].T, cond
+
+
+def _exponent(x: NDArray[np.float64]) -> int:
+    """The e with max |x| / 2^e in [0.5, 1) (0 for an all-zero x)."""
+    largest = float(np.abs(x).max()) if x.size else 0.0
+    return int(np.frexp(largest)[1]) if largest > 0 else 0
+
+
+def _unscale(
+    x: NDArray[np.float64], exponent: int, names: str, what: str, sizes: str
+) -> NDArray[np.float64]:
+    """x * 2^exponent (exact), or a ValueError naming ``names`` if a finite value overflows."""
+    with np.errstate(over="ignore", under="ignore"):
+        out = np.ldexp(x, exponent)
+    if np.any(np.isfinite(x) & ~np.isfinite(out)):
+        raise ValueError(
+            f"{names}: {what} overflows float64 ({sizes}): express Y and tau in other units"
+        )
+    return out
 
 
 def _rank_message(rank: int, p: int, null: NDArray[np.float64], names: list[str] | None) -> str:
@@ -314,12 +360,4 @@ def _choice(value: object, options: tuple[str, ...], name: str) -> str:
 
 
 def _finite(value: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"{name}: expected an array of real numbers, got {type(value).__name__}"
-        ) from None
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name}: contains NaN or inf")
-    return array
+    return real_array(value, name)

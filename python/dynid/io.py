@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import signal as sig
+from ._checks import positive, positive_int, real_array
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -182,11 +183,8 @@ class Log:
 
 
 def _float_array(value: Any, name: str) -> NDArray[np.float64]:
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected a numeric array ({exc})") from None
-    return np.ascontiguousarray(arr)
+    # Non-finite values are reported by _check_finite, with the row (and CSV line) they are on.
+    return np.ascontiguousarray(real_array(value, name, finite=False))
 
 
 def _check_finite(arr: NDArray, name: str, rows: NDArray | None = None) -> None:
@@ -254,7 +252,7 @@ def _load_npz(path: Path) -> Log:
                 f"missing key {name!r} (or FloBaRoID {alias!r}); found keys: {', '.join(found)}"
             )
     for name, arr in arrays.items():
-        if arr.dtype.kind not in "biuf":
+        if arr.dtype.kind not in "iuf":
             raise ValueError(f"key for {name}: expected numbers, got dtype {arr.dtype}")
     how = "FloBaRoID key names" if flobaroid else "dynid key names"
     note = f"loaded from {path.name} (NPZ, {how}; {', '.join(arrays)})"
@@ -460,14 +458,14 @@ def prepare_log(
         raise ValueError(
             f"differentiate: expected 'missing', 'always' or 'never', got {differentiate!r}"
         )
-    factor = sig._positive_int(decimate, "decimate")
-    order = sig._positive_int(order, "order")
+    factor = positive_int(decimate, "decimate")
+    order = positive_int(order, "order")
     if outlier_k is not None:
-        outlier_k = sig._positive(outlier_k, "outlier_k")
+        outlier_k = positive(outlier_k, "outlier_k")
     elif reference_tau is not None:
         raise ValueError("reference_tau: given without outlier_k (the threshold in robust sigmas)")
     if cutoff is not None:
-        cutoff = sig._positive(cutoff, "cutoff")
+        cutoff = positive(cutoff, "cutoff")
         if cutoff >= log.fs / 2:
             raise ValueError(
                 f"cutoff: expected 0 < cutoff < fs/2 = {log.fs / 2:g} Hz, got {cutoff:g} Hz"
@@ -478,7 +476,7 @@ def prepare_log(
         raise ValueError("min_velocity: needs qd, but the log has none and differentiate='never'")
     reference = None
     if reference_tau is not None and not callable(reference_tau):
-        reference = sig._array(reference_tau, "reference_tau")
+        reference = real_array(reference_tau, "reference_tau")
         if reference.shape != log.tau.shape:
             raise ValueError(
                 f"reference_tau: expected one row per sample of the input log, shape "
@@ -548,7 +546,7 @@ def prepare_log(
             predicted = reference[index]
             what = "reference_tau (given)"
         else:
-            predicted = sig._array(reference_tau(log), "reference_tau(log)")  # type: ignore[operator]
+            predicted = real_array(reference_tau(log), "reference_tau(log)")  # type: ignore[operator]
             what = "reference_tau(log)"
             if predicted.shape != log.tau.shape:
                 raise ValueError(

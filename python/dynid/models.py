@@ -10,6 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from . import _core
 from .robot import Robot
 
 __all__ = ["kuka_lwr4", "planar_2r", "puma560"]
@@ -68,18 +69,6 @@ _PUMA_DRIVES = np.array([
     [33e-6,   71.923,   82.6e-6,  9.26e-3, -14.5e-3],
     [33e-6,   76.686,   36.7e-6,  3.96e-3, -10.5e-3],
 ])  # fmt: skip
-
-
-def _standard_row(mass: float, com: Sequence[float], inertia_com: np.ndarray) -> np.ndarray:
-    """Standard parameters ``[m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz]`` of one link.
-
-    Steiner (SPEC §2): I = I_c + m (|c|^2 E - c c^T). Used for the PUMA 560, whose published
-    links 1 and 3 are not physically consistent, so ``Robot.set_link`` would refuse them.
-    """
-    c = np.asarray(com, dtype=float)
-    inertia = np.asarray(inertia_com, dtype=float) + mass * (c @ c * np.eye(3) - np.outer(c, c))
-    # np.triu_indices(3) walks xx, xy, xz, yy, yz, zz: exactly the SPEC order
-    return np.concatenate(([mass], mass * c, inertia[np.triu_indices(3)]))
 
 
 def kuka_lwr4() -> Robot:
@@ -174,8 +163,9 @@ def planar_2r(
     convention : {"standard", "modified"}
         ``"modified"`` describes the same arm with frames at the joints (rows ``[0, 0, 0, 0]``,
         ``[l1, 0, 0, 0]``, tool ``Tx(l2)``, CoM ``(lc_i, 0, 0)``): the frames of the notes'
-        linear parametrisation, whose base parameters are ``mx1 + l1*m2``, ``Izz1 + l1**2*m2``,
-        ``mx2``, ``Izz2`` (the notes' a1..a4).
+        linear parametrisation, whose base parameters in the vertical plane are
+        ``mx1 + l1*m2``, ``Izz1 + l1**2*m2``, ``mx2``, ``Izz2`` (the notes' a1..a4) and ``my1``,
+        ``my2`` (zero here: the CoMs are on the link axes); see docs/base_parameters.md.
 
     Returns
     -------
@@ -228,7 +218,7 @@ def puma560() -> Robot:
     does not enter the dynamics, only its inertia 0.35 kg m^2 about the joint-1 axis does,
     and its Ixx = Izz = 0) and link 3's inertia violates the triangle inequality
     (Ixx + Izz = 0.0785 < Iyy = 0.086). ``set_link`` would refuse both, so all links are
-    given as standard parameters (Steiner applied here).
+    given as standard parameters (Steiner applied by the core, without the check).
 
     Returns
     -------
@@ -238,7 +228,10 @@ def puma560() -> Robot:
     """
     links = _PUMA_LINKS
     dh = np.column_stack([links[:, 0], links[:, 1], links[:, 2], np.zeros(6)])
-    params = np.array([_standard_row(row[3], row[4:7], np.diag(row[7:10])) for row in links])
+    # The core's Steiner transform (SPEC §2), which unlike set_link does not check consistency.
+    params = np.array(
+        [_core.standard_parameters(row[3], row[4:7], np.diag(row[7:10])) for row in links]
+    )
     robot = Robot.from_dh(
         dh,
         joint_types="R" * 6,

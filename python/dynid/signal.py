@@ -23,6 +23,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import signal as _sp
 from scipy.ndimage import median_filter
 
+from ._checks import positive, positive_int, real_array
+
 #: Anti-aliasing cutoff of :func:`decimate` as a fraction of the new Nyquist frequency (the value
 #: scipy.signal.decimate uses): the band kept is undistorted, the band folded back is attenuated.
 ANTIALIAS_FRACTION = 0.8
@@ -40,33 +42,10 @@ SPIKE_FLOOR = 1e-3
 
 
 def _array(x: ArrayLike, name: str, min_ndim: int = 1) -> NDArray[np.float64]:
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected a numeric array, got {type(x).__name__} ({exc})") from None
+    arr = real_array(x, name)
     if arr.ndim < min_ndim:
         raise ValueError(f"{name}: expected at least {min_ndim} dimension(s), got shape {arr.shape}")
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        where = tuple(int(i[0]) for i in np.nonzero(bad))
-        raise ValueError(f"{name}: non-finite value {arr[where]} at index {where}")
     return arr
-
-
-def _positive(value: Any, name: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a positive number, got {value!r}") from None
-    if not np.isfinite(v) or v <= 0.0:
-        raise ValueError(f"{name}: expected a positive finite number, got {value!r}")
-    return v
-
-
-def _positive_int(value: Any, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"{name}: expected a positive integer, got {value!r}")
-    return int(value)
 
 
 def _axis(x: NDArray, axis: int, name: str = "x") -> int:
@@ -147,9 +126,9 @@ def lowpass(
     """
     arr = _array(x, "x")
     ax = _axis(arr, axis)
-    fs = _positive(fs, "fs")
-    cutoff = _positive(cutoff, "cutoff")
-    order = _positive_int(order, "order")
+    fs = positive(fs, "fs")
+    cutoff = positive(cutoff, "cutoff")
+    order = positive_int(order, "order")
     if cutoff >= fs / 2:
         raise ValueError(
             f"cutoff: expected 0 < cutoff < fs/2 = {fs / 2:g} Hz (Nyquist), got {cutoff:g} Hz"
@@ -213,7 +192,7 @@ def differentiate(
         raise ValueError(f"x: expected at least 2 samples along axis {ax}, got {length}")
     edge_order = 2 if length >= 3 else 1
     if fs is not None:
-        return np.gradient(arr, 1.0 / _positive(fs, "fs"), axis=ax, edge_order=edge_order)
+        return np.gradient(arr, 1.0 / positive(fs, "fs"), axis=ax, edge_order=edge_order)
     t = check_time(t)
     if t.size != length:
         raise ValueError(f"t: has {t.size} samples but x has {length} along axis {ax}")
@@ -246,8 +225,8 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
         data, factor = data[:-1], data[-1]
     if factor is None:
         raise ValueError("factor: missing; call decimate(x, factor) or decimate(log, factor)")
-    factor = _positive_int(factor, "factor")
-    order = _positive_int(order, "order")
+    factor = positive_int(factor, "factor")
+    order = positive_int(order, "order")
     if not data:
         raise ValueError("data: nothing to decimate")
     wn = ANTIALIAS_FRACTION / factor  # cutoff in units of the old Nyquist frequency
@@ -357,7 +336,7 @@ def outlier_mask(
     r = _array(residual, "residual")
     if r.ndim > 2:
         raise ValueError(f"residual: expected shape (T, n) or (T,), got {r.shape}")
-    k = _positive(k, "k")
+    k = positive(k, "k")
     columns = r.reshape(r.shape[0], -1)
     floor = _per_column(min_sigma, "min_sigma", columns.shape[1], "column")
     deviation = np.abs(columns - np.median(columns, axis=0))
@@ -398,18 +377,18 @@ def spike_mask(
     arr = _array(x, "x")
     if arr.ndim > 2:
         raise ValueError(f"x: expected shape (T, n) or (T,), got {arr.shape}")
-    fs = _positive(fs, "fs")
+    fs = positive(fs, "fs")
     if window is None:
         window = max(7, 2 * round(fs / 20) + 1)
-    window = _positive_int(window, "window")
+    window = positive_int(window, "window")
     if window < 5 or window % 2 == 0:
         raise ValueError(f"window: expected an odd number of samples >= 5, got {window}")
-    iterations = _positive_int(iterations, "iterations")
+    iterations = positive_int(iterations, "iterations")
     columns = arr.reshape(arr.shape[0], -1)
     if columns.shape[0] < window:
         raise ValueError(f"x: {columns.shape[0]} samples are fewer than the window of {window}")
     spread = MAD_TO_SIGMA * np.median(np.abs(columns - np.median(columns, axis=0)), axis=0)
-    floor = _positive(relative_floor, "relative_floor") * spread
+    floor = positive(relative_floor, "relative_floor") * spread
     mask = np.zeros(columns.shape, dtype=bool)
     smoothed = columns
     for _ in range(iterations):

@@ -7,6 +7,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._checks import real_array
+
 
 def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArray[np.float64]]:
     """Per-column (joint) errors of ``predicted`` against ``measured``, both (T, n).
@@ -16,14 +18,22 @@ def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArra
     (coefficient of determination, 1 - SSE / SST about the mean; NaN-free: 1.0 for a constant
     signal predicted exactly, -inf if it is not).
     """
-    measured = np.atleast_2d(np.asarray(measured, dtype=float))
-    predicted = np.atleast_2d(np.asarray(predicted, dtype=float))
+    measured = np.atleast_2d(real_array(measured, "measured"))
+    predicted = np.atleast_2d(real_array(predicted, "predicted"))
+    if measured.size == 0:
+        raise ValueError(
+            f"measured: expected at least one sample (T, n) with T, n >= 1, got shape "
+            f"{measured.shape}"
+        )
     if measured.shape != predicted.shape:
         raise ValueError(
             f"predicted: expected the shape of measured {measured.shape}, got {predicted.shape}"
         )
-    if not (np.all(np.isfinite(measured)) and np.all(np.isfinite(predicted))):
-        raise ValueError("measured, predicted: contain NaN or inf")
+    # Computed in units where the largest value is in [0.5, 1) (an exact power-of-two scaling),
+    # so that the squares of values beyond ~1e154 do not overflow; scaled back at the end.
+    largest = max(float(np.abs(measured).max()), float(np.abs(predicted).max()))
+    exponent = int(np.frexp(largest)[1]) if largest > 0 else 0
+    measured, predicted = np.ldexp(measured, -exponent), np.ldexp(predicted, -exponent)
     error = predicted - measured
     sse = np.sum(error**2, axis=0)
     sst = np.sum((measured - measured.mean(axis=0)) ** 2, axis=0)
@@ -32,10 +42,17 @@ def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArra
         r2 = np.where(sst > 0.0, 1.0 - sse / sst, np.where(sse == 0.0, 1.0, -np.inf))
         relative = np.where(rms_measured > 0.0, np.sqrt(np.mean(error**2, axis=0)) / rms_measured,
                             np.where(sse == 0.0, 0.0, np.inf))
+    with np.errstate(over="ignore"):
+        mse = np.ldexp(np.mean(error**2, axis=0), 2 * exponent)
+    if not np.all(np.isfinite(mse)):
+        raise ValueError(
+            f"measured, predicted: the mean square error overflows float64 (values up to "
+            f"{largest:.3g}); express them in other units"
+        )
     return {
-        "mse": np.mean(error**2, axis=0),
-        "max_abs": np.max(np.abs(error), axis=0),
-        "rms": np.sqrt(np.mean(error**2, axis=0)),
+        "mse": mse,
+        "max_abs": np.ldexp(np.max(np.abs(error), axis=0), exponent),
+        "rms": np.ldexp(np.sqrt(np.mean(error**2, axis=0)), exponent),
         "relative_rms": relative,
         "r2": r2,
     }

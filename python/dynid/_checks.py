@@ -1,0 +1,117 @@
+"""Input checks shared by the Python modules (SPEC §2: bad input raises ``ValueError`` whose
+message starts with the argument's name and says what was expected and what was given).
+
+One conversion for every array argument, :func:`real_array`: NumPy's own ``float`` cast would
+silently drop the imaginary part of complex numbers (a ComplexWarning at most), turn booleans
+into 0/1 and accept objects or strings that happen to convert, so the dtype is checked before
+the cast.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+#: dtype kinds accepted as real numbers: signed and unsigned integers, floats.
+REAL_KINDS = "iuf"
+
+# NumPy < 1.24 warns (and makes an object array) where later versions raise for ragged input.
+_RAGGED_WARNING = getattr(np, "exceptions", np).VisibleDeprecationWarning
+
+_KIND_NAMES = {
+    "b": "booleans",
+    "c": "complex numbers",
+    "O": "Python objects",
+    "U": "strings",
+    "S": "bytes",
+    "V": "structured values",
+    "M": "datetimes",
+    "m": "timedeltas",
+}
+
+
+def real_array(
+    value: ArrayLike, name: str, *, ndim: int | None = None, finite: bool = True
+) -> NDArray[np.float64]:
+    """``value`` as a float64 array of real numbers, checked.
+
+    Raises ``ValueError`` naming ``name`` when ``value`` is ragged (nested sequences of unequal
+    lengths), is not made of real numbers (``dtype.kind`` outside "iuf": complex, bool, object,
+    strings, ...), has not ``ndim`` dimensions (when given) or, with ``finite`` (default), holds
+    NaN or inf. The result is not copied when ``value`` already is a float64 array; pass
+    ``finite=False`` only when the caller reports non-finite values itself, in more detail.
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", _RAGGED_WARNING)
+            array = np.asarray(value)
+    except (ValueError, _RAGGED_WARNING) as exc:
+        text = str(exc)
+        if "inhomogeneous" in text or "ragged" in text:
+            raise ValueError(
+                f"{name}: expected a rectangular array of real numbers, got ragged nested "
+                f"sequences (rows of different lengths): {text}"
+            ) from None
+        raise ValueError(
+            f"{name}: expected an array of real numbers, got {type(value).__name__} ({text})"
+        ) from None
+    except TypeError as exc:
+        raise ValueError(
+            f"{name}: expected an array of real numbers, got {type(value).__name__} ({exc})"
+        ) from None
+    if array.dtype.kind not in REAL_KINDS:
+        what = _KIND_NAMES.get(array.dtype.kind, "non-real values")
+        raise ValueError(
+            f"{name}: expected real numbers (integer or float), got {what} "
+            f"(dtype {array.dtype}) from {type(value).__name__}"
+        )
+    array = array.astype(np.float64, copy=False)
+    if ndim is not None and array.ndim != ndim:
+        raise ValueError(
+            f"{name}: expected a {ndim}-dimensional array, got shape {array.shape}"
+        )
+    if finite:
+        check_finite(array, name)
+    return array
+
+
+def check_finite(array: NDArray[np.float64], name: str) -> None:
+    """Raise ``ValueError`` naming ``name`` and the first NaN or inf and its index."""
+    bad = ~np.isfinite(array)
+    if bad.any():
+        if array.ndim == 0:
+            raise ValueError(f"{name}: expected a finite number, got {array}")
+        where = tuple(int(i[0]) for i in np.nonzero(bad))
+        raise ValueError(f"{name}: non-finite value {array[where]} at index {where}")
+
+
+def positive(value: Any, name: str) -> float:
+    """A positive finite number (bool refused), as a float."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected a positive number, got {value!r}")  # noqa: TRY004 -- SPEC 2
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a positive number, got {value!r}") from None
+    if not np.isfinite(v) or v <= 0.0:
+        raise ValueError(f"{name}: expected a positive finite number, got {value!r}")
+    return v
+
+
+def positive_int(value: Any, name: str) -> int:
+    """An integer >= 1 (bool refused), as an int."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"{name}: expected a positive integer, got {value!r}")
+    return int(value)
+
+
+def count(value: Any, name: str, minimum: int, why: str = "") -> int:
+    """An integer >= ``minimum`` (bool refused); ``why`` explains the minimum in the message."""
+    integral = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+    if not integral or value < minimum:
+        reason = f" ({why})" if why else ""
+        raise ValueError(f"{name}: expected an integer >= {minimum}{reason}, got {value!r}")
+    return int(value)
