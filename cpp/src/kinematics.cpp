@@ -1,8 +1,18 @@
 #include "dynid/kinematics.hpp"
 
+#include <stdexcept>
+#include <string>
+
 namespace dynid {
 
 void update_joint_transforms(const Model& model, Workspace& ws, const VectorIn& q) {
+  // Every algorithm starts here: one cheap check catches a workspace made for another model or a
+  // q of the wrong length (the Python binding checks shapes before; C++ callers may not).
+  if (ws.n != model.n() || q.size() != model.n())
+    throw std::invalid_argument("q: expected " + std::to_string(model.n()) +
+                                " joint values and a Workspace of this model, got " +
+                                std::to_string(q.size()) + " values and a workspace for " +
+                                std::to_string(ws.n) + " joints");
   for (int i = 1; i <= ws.n; ++i) {
     const JointGeometry& j = model.joint(i - 1);
     const double qi = q[i - 1];

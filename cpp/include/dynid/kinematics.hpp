@@ -8,6 +8,7 @@
 namespace dynid {
 
 // ws.X[i] = J_{i-1} -> J_i at q (theta = q + offset for revolute, d = q + offset for prismatic).
+// Throws std::invalid_argument when q or the workspace do not fit the model.
 void update_joint_transforms(const Model& model, Workspace& ws, const VectorIn& q);
 
 // ws.R_world[i], ws.p_world[i]: world pose of J_i (index 0: the base), from ws.X.
