@@ -245,3 +245,13 @@ def lagrange_torque(arm: Arm, q: Array, qd: Array, qdd: Array, h: float = 1e-6) 
         dm = (mass_matrix(arm, q + e) - mass_matrix(arm, q - e)) / (2 * h)
         dt_dq[k] = 0.5 * qd @ dm @ qd
     return m_q @ qdd + m_dot @ qd - dt_dq + gravity(arm, q) + friction(arm, qd)
+
+
+def arm_of(robot) -> Arm:
+    """The same arm as a dynid robot, in this reference model (no drive terms)."""
+    links = [params_to_physical(p) for p in robot.params]
+    return Arm(
+        dh=np.array(robot.dh), joint_types=robot.joint_types, convention=robot.convention,
+        mass=np.array([m for m, _, _ in links]), com=np.array([c for _, c, _ in links]),
+        inertia_com=np.array([i for _, _, i in links]), gravity=np.array(robot.gravity_vector),
+    )

@@ -21,25 +21,6 @@ D1, D2 = 0.4, 0.39  # the LWR's d_3 and d_5 (paper Table I)
 TRUTHS = {"controller_model": controller_model, "kuka_lwr4": dynid.models.kuka_lwr4}
 
 
-def rigid(robot: dynid.Robot) -> dynid.Robot:
-    """A copy without drive terms: the link equation (7) the controller's M and g describe."""
-    out = robot.copy()
-    out.Ia = np.zeros(out.n)
-    out.Fv = np.zeros(out.n)
-    out.Fs = np.zeros(out.n)
-    return out
-
-
-def reference_arm(robot: dynid.Robot) -> ref.Arm:
-    """The same arm in the independent NumPy reference model (no drive terms)."""
-    links = [ref.params_to_physical(p) for p in robot.params]
-    return ref.Arm(
-        dh=np.array(robot.dh), joint_types=robot.joint_types, convention=robot.convention,
-        mass=np.array([m for m, _, _ in links]), com=np.array([c for _, c, _ in links]),
-        inertia_com=np.array([i for _, _, i in links]), gravity=np.array(robot.gravity_vector),
-    )
-
-
 def identify(truth: dynid.Robot, count: int, seed: int, method: str = "ols", **noise):
     controller = VirtualController(truth, seed=seed, **noise)
     data = controller.read_static(controller.random_configurations(count))
@@ -73,7 +54,7 @@ def test_noise_free_model_matches_the_independent_reference_model(noise_free):
     # M = sum m J_v^T J_v + J_w^T R I_c R^T J_w and g = -sum m J_v^T g0 (reference_model.py,
     # no drive terms), 1e-9 relative to max|M|, max|g|, on 8 fresh configurations.
     truth, ident, check = noise_free
-    arm = reference_arm(truth)
+    arm = ref.arm_of(truth)
     for q in check.q[:8]:
         M_ref, g_ref = ref.mass_matrix(arm, q), ref.gravity(arm, q)
         assert np.abs(ident.mass_matrix(q) - M_ref).max() <= 1e-9 * np.abs(M_ref).max()
@@ -117,14 +98,14 @@ def test_noise_free_tau_J_equals_the_rigid_robots_rnea(noise_free):
     rng = np.random.default_rng(3)
     q = truth.random_configurations(40, seed=4)
     qd, qdd = rng.uniform(-2, 2, q.shape), rng.uniform(-5, 5, q.shape)
-    tau = rigid(truth).rnea(q, qd, qdd)
+    tau = truth.rigid_body().rnea(q, qd, qdd)
     error = np.abs(ident.rnea(q, qd, qdd) - tau).max()
     assert error <= 1e-9 * np.abs(tau).max(), error
     # one sample at a time as well (SPEC §2 shapes)
     np.testing.assert_allclose(ident.rnea(q[0], qd[0], qdd[0]), tau[0], rtol=0,
                                atol=1e-9 * np.abs(tau).max())
     # and against Lagrange's equations on the reference model (finite differences, ~1e-7)
-    arm = reference_arm(truth)
+    arm = ref.arm_of(truth)
     lagrange = ref.lagrange_torque(arm, q[1], qd[1], qdd[1])
     np.testing.assert_allclose(ident.rnea(q[1], qd[1], qdd[1]), lagrange, rtol=0,
                                atol=1e-6 * np.abs(lagrange).max())

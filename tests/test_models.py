@@ -94,3 +94,16 @@ def test_planar_2r_default_matches_the_closed_form_of_the_notes():
             ])
             np.testing.assert_allclose(robot.mass_matrix([q1, q2]), M, rtol=0, atol=1e-12)
             np.testing.assert_allclose(robot.gravity([q1, q2]), g, rtol=0, atol=1e-12)
+
+
+def test_rigid_body_copy_drops_only_the_drive_terms():
+    robot = dynid.models.kuka_lwr4()
+    body = robot.rigid_body()
+    for name in ("Ia", "Fv", "Fs"):
+        assert np.all(getattr(robot, name) > 0.0)  # the original keeps its drive terms
+        np.testing.assert_array_equal(getattr(body, name), np.zeros(robot.n))
+    np.testing.assert_array_equal(body.params, robot.params)
+    q, qd, qdd = np.random.default_rng(3).uniform(-1.0, 1.0, (3, robot.n))
+    # tau of the links alone = full tau minus the rotor and friction terms, written out here
+    expected = robot.rnea(q, qd, qdd) - robot.Ia * qdd - robot.Fv * qd - robot.Fs * np.sign(qd)
+    np.testing.assert_allclose(body.rnea(q, qd, qdd), expected, rtol=1e-12, atol=1e-12)

@@ -16,24 +16,6 @@ import reference_model as ref
 from dynid.demo import controller_model
 from dynid.sim import VirtualController, paper_validation_trajectory
 
-
-def rigid(robot: dynid.Robot) -> dynid.Robot:
-    out = robot.copy()
-    out.Ia = np.zeros(out.n)
-    out.Fv = np.zeros(out.n)
-    out.Fs = np.zeros(out.n)
-    return out
-
-
-def reference_arm(robot: dynid.Robot) -> ref.Arm:
-    links = [ref.params_to_physical(p) for p in robot.params]
-    return ref.Arm(
-        dh=np.array(robot.dh), joint_types=robot.joint_types, convention=robot.convention,
-        mass=np.array([m for m, _, _ in links]), com=np.array([c for _, c, _ in links]),
-        inertia_com=np.array([i for _, _, i in links]), gravity=np.array(robot.gravity_vector),
-    )
-
-
 # --- static readings -----------------------------------------------------------------------------
 
 
@@ -47,12 +29,12 @@ def test_noise_free_readings_are_the_link_dynamics_without_drive_terms():
     data = controller.read_static(q)
     np.testing.assert_array_equal(data.q, q)
     assert data.g.shape == (20, 7) and data.M.shape == (20, 7, 7)
-    body = rigid(robot)
+    body = robot.rigid_body()
     np.testing.assert_allclose(data.g, body.gravity(q), rtol=0,
                                atol=1e-14 * np.abs(data.g).max())
     np.testing.assert_allclose(data.M, body.mass_matrix(q), rtol=0,
                                atol=1e-14 * np.abs(data.M).max())
-    arm = reference_arm(robot)
+    arm = ref.arm_of(robot)
     for k in range(3):
         np.testing.assert_allclose(data.M[k], ref.mass_matrix(arm, q[k]), rtol=0,
                                    atol=1e-10 * np.abs(data.M).max())
@@ -68,7 +50,7 @@ def test_one_configuration_is_one_sample():
     q = robot.random_configurations(1, seed=2)[0]
     data = VirtualController(robot).read_static(q)
     assert data.q.shape == (1, 7) and data.g.shape == (1, 7) and data.M.shape == (1, 7, 7)
-    np.testing.assert_allclose(data.g[0], rigid(robot).gravity(q), rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(data.g[0], robot.rigid_body().gravity(q), rtol=1e-14, atol=1e-14)
 
 
 def test_random_configurations_are_uniform_within_the_joint_limits():
@@ -121,7 +103,7 @@ def test_position_noise_is_added_to_the_reported_q_only():
     q = controller.random_configurations(1000)
     data = controller.read_static(q)
     assert np.std(data.q - q) == pytest.approx(sigma, rel=0.05)
-    np.testing.assert_allclose(data.g, rigid(robot).gravity(q), rtol=0,
+    np.testing.assert_allclose(data.g, robot.rigid_body().gravity(q), rtol=0,
                                atol=1e-14 * np.abs(data.g).max())
 
 
@@ -154,7 +136,7 @@ def test_track_records_the_link_torques_at_the_given_rate():
     np.testing.assert_allclose(record.t, np.arange(501) / 250.0, rtol=0, atol=1e-15)
     q, qd, qdd = paper_validation_trajectory(record.t, robot.n)
     np.testing.assert_array_equal(record.q, q)
-    body = rigid(robot)
+    body = robot.rigid_body()
     expected = (np.einsum("tij,tj->ti", body.mass_matrix(q), qdd) + body.coriolis(q, qd)
                 + body.gravity(q))
     np.testing.assert_allclose(record.tau, expected, rtol=0,

@@ -290,10 +290,7 @@ def _expand(
 
 def _robot_with(structure: Robot, base: BaseParameters, coefficients: NDArray) -> Robot:
     """A robot of the same structure whose standard parameters give these base coefficients."""
-    robot = structure.copy()
-    robot.Ia = np.zeros(robot.n)
-    robot.Fv = np.zeros(robot.n)
-    robot.Fs = np.zeros(robot.n)
+    robot = structure.rigid_body()
     pi = np.zeros(10 * robot.n)
     pi[base.independent] = coefficients  # beta[:, independent] = I, so beta @ pi = coefficients
     robot.params = pi

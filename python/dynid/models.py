@@ -90,11 +90,7 @@ def kuka_lwr4() -> Robot:
 
     Small plausible drive terms are set too: ``Ia`` (reflected rotor inertia), ``Fv`` and
     ``Fs`` (link-side viscous and Coulomb friction). For the pure rigid-body arm of the
-    paper, zero them::
-
-        robot.Ia = np.zeros(robot.n)
-        robot.Fv = np.zeros(robot.n)
-        robot.Fs = np.zeros(robot.n)
+    paper, use ``robot.rigid_body()`` (a copy with the drive terms zeroed).
 
     Returns
     -------

@@ -208,6 +208,13 @@ class Robot(_core.Model):
         other.params = params
         return other
 
+    def rigid_body(self) -> Robot:
+        """A copy without drive terms (Ia = Fv = Fs = 0): the links alone, e.g. the link
+        equation of an arm with elastic joints (paper eq. (7))."""
+        other = self.copy()
+        other.Ia = other.Fv = other.Fs = np.zeros(self.n)
+        return other
+
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
         if isinstance(count, (bool, np.bool_)) or not isinstance(count, (int, np.integer)) or count < 0:

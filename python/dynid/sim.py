@@ -77,10 +77,7 @@ class VirtualController:
         ):
             if not (np.isfinite(value) and value >= 0.0):
                 raise ValueError(f"{name}: expected a finite value >= 0, got {value!r}")
-        self.robot = robot.copy()
-        self.robot.Ia = np.zeros(robot.n)
-        self.robot.Fv = np.zeros(robot.n)
-        self.robot.Fs = np.zeros(robot.n)
+        self.robot = robot.rigid_body()
         self.model_noise = float(model_noise)
         self.torque_noise = float(torque_noise)
         self.position_noise = float(position_noise)
