@@ -25,12 +25,6 @@ void require_length(const VectorIn& v, int n, const char* name) {
   if (!v.allFinite()) throw std::invalid_argument(std::string(name) + ": non-finite value");
 }
 
-Matrix3 rotation_x(double c, double s) {
-  Matrix3 R;
-  R << 1, 0, 0, 0, c, -s, 0, s, c;
-  return R;
-}
-
 }  // namespace
 
 Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& gravity,
@@ -61,8 +55,6 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   // frame sits at J_i * Tx(a_i) Rx(alpha_i).
   joints_.resize(n_);
   offsets_.assign(n_, LinkOffset{});
-  offset_R_.assign(n_, Matrix3::Identity());
-  offset_p_.assign(n_, Vector3::Zero());
   for (int i = 0; i < n_; ++i) {
     const DHRow& r = rows_[i];
     JointGeometry& j = joints_[i];
@@ -82,8 +74,6 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
     j.sin_alpha = std::sin(alpha);
     if (convention_ == Convention::Standard) {
       offsets_[i] = LinkOffset{false, std::cos(r.alpha), std::sin(r.alpha), r.a};
-      offset_R_[i] = rotation_x(offsets_[i].cos_alpha, offsets_[i].sin_alpha);
-      offset_p_[i] = Vector3(r.a, 0.0, 0.0);
     }
   }
   update_frames();
@@ -105,13 +95,13 @@ void Model::set_base(const Matrix4& base) {
 void Model::set_tool(const Matrix4& tool) {
   require_homogeneous(tool, "tool");
   tool_ = tool;
-  if (!offset_R_.empty()) update_frames();
+  if (!offsets_.empty()) update_frames();
 }
 
 void Model::update_frames() {
   Matrix4 offset = Matrix4::Identity();
-  offset.topLeftCorner<3, 3>() = offset_R_[n_ - 1];
-  offset.topRightCorner<3, 1>() = offset_p_[n_ - 1];
+  offset.topLeftCorner<3, 3>() = offsets_[n_ - 1].rotation();
+  offset.topRightCorner<3, 1>() = offsets_[n_ - 1].translation();
   flange_to_tool_ = offset * tool_;
 }
 
@@ -154,8 +144,8 @@ void Model::update_bodies() {
   for (int i = 0; i < n_; ++i) {
     double row[10];
     for (int k = 0; k < 10; ++k) row[k] = parameters_(i, k);
-    bodies_[i] = RigidBodyParameters::from_standard(row).expressed_in_parent(offset_R_[i],
-                                                                             offset_p_[i]);
+    bodies_[i] = RigidBodyParameters::from_standard(row).expressed_in_parent(
+        offsets_[i].rotation(), offsets_[i].translation());
   }
 }
 

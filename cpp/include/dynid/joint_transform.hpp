@@ -33,11 +33,6 @@ struct JointTransform {
     const double y2 = -sa * x.y() + ca * x.z();
     return Vector3(ct * x.x() + st * y1, -st * x.x() + ct * y1, y2);
   }
-  Matrix3 rotation() const {
-    Matrix3 R;
-    R << ct, -st, 0.0, ca * st, ca * ct, -sa, sa * st, sa * ct, ca;
-    return R;
-  }
 };
 
 inline void JointTransform::set(double cos_alpha, double sin_alpha, double a, double theta,

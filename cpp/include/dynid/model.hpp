@@ -30,6 +30,13 @@ struct LinkOffset {
   bool identity = true;
   double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
 
+  Matrix3 rotation() const {  // Rx(alpha)
+    Matrix3 R;
+    R << 1.0, 0.0, 0.0, 0.0, cos_alpha, -sin_alpha, 0.0, sin_alpha, cos_alpha;
+    return R;
+  }
+  Vector3 translation() const { return Vector3(a, 0.0, 0.0); }
+
   // Rx(alpha)^T x: a vector of J_i in the axes of DH frame i.
   Vector3 rotate_to_link(const Vector3& x) const {
     return Vector3(x.x(), cos_alpha * x.y() + sin_alpha * x.z(),
@@ -78,8 +85,6 @@ class Model {
   const RigidBodyParameters& body(int i) const { return bodies_[i]; }
   // DH frame i = J_i * link_offset(i): identity for modified DH, Tx(a_i) Rx(alpha_i) for standard.
   const LinkOffset& link_offset(int i) const { return offsets_[i]; }
-  const Matrix3& link_offset_rotation(int i) const { return offset_R_[i]; }
-  const Vector3& link_offset_translation(int i) const { return offset_p_[i]; }
   // Gravity expressed in frame 0 (the base frame).
   const Vector3& gravity_base() const { return gravity_base_; }
   // Frame J_n -> tool: link_offset(n-1) * tool.
@@ -100,8 +105,6 @@ class Model {
   std::vector<JointGeometry> joints_;
   std::vector<RigidBodyParameters> bodies_;
   std::vector<LinkOffset> offsets_;
-  std::vector<Matrix3> offset_R_;
-  std::vector<Vector3> offset_p_;
   Vector3 gravity_base_;
   Matrix4 flange_to_tool_;
 };
