@@ -54,10 +54,10 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   // constant Tx(a_{i-1}) Rx(alpha_{i-1}) of the previous row precedes joint i, and link i's DH
   // frame sits at J_i * Tx(a_i) Rx(alpha_i).
   joints_.resize(n_);
-  offsets_.assign(n_, LinkOffset{});
+  offsets_.assign(n_, detail::LinkOffset{});
   for (int i = 0; i < n_; ++i) {
     const DHRow& r = rows_[i];
-    JointGeometry& j = joints_[i];
+    detail::JointGeometry& j = joints_[i];
     j.revolute = r.type == JointType::Revolute;
     j.theta = r.theta;
     j.d = r.d;
@@ -73,7 +73,7 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
     j.cos_alpha = std::cos(alpha);
     j.sin_alpha = std::sin(alpha);
     if (convention_ == Convention::Standard) {
-      offsets_[i] = LinkOffset{false, std::cos(r.alpha), std::sin(r.alpha), r.a};
+      offsets_[i] = detail::LinkOffset{false, std::cos(r.alpha), std::sin(r.alpha), r.a};
     }
   }
   update_frames();

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "dynid/detail/joint_geometry.hpp"
 #include "dynid/rigid_body.hpp"
 #include "dynid/types.hpp"
 
@@ -23,32 +24,6 @@ struct DHRow {
   double d = 0.0;
   double theta = 0.0;
   JointType type = JointType::Revolute;
-};
-
-// DH frame i relative to joint frame J_i: Tx(a) Rx(alpha) (standard DH), identity (modified).
-struct LinkOffset {
-  bool identity = true;
-  double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
-
-  Matrix3 rotation() const {  // Rx(alpha)
-    Matrix3 R;
-    R << 1.0, 0.0, 0.0, 0.0, cos_alpha, -sin_alpha, 0.0, sin_alpha, cos_alpha;
-    return R;
-  }
-  Vector3 translation() const { return Vector3(a, 0.0, 0.0); }
-
-  // Rx(alpha)^T x: a vector of J_i in the axes of DH frame i.
-  Vector3 rotate_to_link(const Vector3& x) const {
-    return Vector3(x.x(), cos_alpha * x.y() + sin_alpha * x.z(),
-                   -sin_alpha * x.y() + cos_alpha * x.z());
-  }
-};
-
-// Constant part of joint i in the modified form used by the algorithms (joint_transform.hpp).
-struct JointGeometry {
-  double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
-  double theta = 0.0, d = 0.0;  // offsets to which q adds
-  bool revolute = true;
 };
 
 class Model {
@@ -80,11 +55,11 @@ class Model {
   void set_coulomb_friction(const VectorIn& Fs);
 
   // ---- derived quantities the algorithms use ----
-  const JointGeometry& joint(int i) const { return joints_[i]; }
+  const detail::JointGeometry& joint(int i) const { return joints_[i]; }
   // Link i's parameters about the origin of its joint frame J_i.
   const RigidBodyParameters& body(int i) const { return bodies_[i]; }
   // DH frame i = J_i * link_offset(i): identity for modified DH, Tx(a_i) Rx(alpha_i) for standard.
-  const LinkOffset& link_offset(int i) const { return offsets_[i]; }
+  const detail::LinkOffset& link_offset(int i) const { return offsets_[i]; }
   // Gravity expressed in frame 0 (the base frame).
   const Vector3& gravity_base() const { return gravity_base_; }
   // Frame J_n -> tool: link_offset(n-1) * tool.
@@ -102,9 +77,9 @@ class Model {
   MatrixX parameters_;
   VectorX Ia_, Fv_, Fs_;
 
-  std::vector<JointGeometry> joints_;
+  std::vector<detail::JointGeometry> joints_;
   std::vector<RigidBodyParameters> bodies_;
-  std::vector<LinkOffset> offsets_;
+  std::vector<detail::LinkOffset> offsets_;
   Vector3 gravity_base_;
   Matrix4 flange_to_tool_;
 };
