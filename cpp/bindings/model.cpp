@@ -215,15 +215,7 @@ void bind_model(py::module_& m) {
           py::arg("i"), py::arg("mass"), py::arg("com"), py::arg("inertia_com"))
       .def(
           "_link_inconsistency",
-          [](const PyModel& self, int i) {
-            if (i < 0 || i >= self.model->n())
-              throw py::value_error("i: expected a link index in [0, " + std::to_string(self.model->n()) +
-                                    "), got " + std::to_string(i));
-            const RigidBodyParameters b = RigidBodyParameters::from_standard(
-                Eigen::Matrix<double, 1, 10>(self.model->parameters().row(i)).data());
-            if (!(b.m > 0.0)) return physical_inconsistency(b.m, Matrix3::Identity());
-            return physical_inconsistency(b.m, b.inertia_about_com());
-          },
+          [](const PyModel& self, int i) { return self.model->link_inconsistency(i); },
           "Why link i (0-based) is not physically consistent, or '' when it is.")
       .def(
           "rnea",

@@ -126,6 +126,15 @@ void Model::set_link(int i, const RigidBodyParameters& body) {
   update_bodies();
 }
 
+std::string Model::link_inconsistency(int i) const {
+  if (i < 0 || i >= n_)
+    throw std::invalid_argument("i: expected a link index in [0, " + std::to_string(n_) +
+                                "), got " + std::to_string(i));
+  double row[10];
+  for (int k = 0; k < 10; ++k) row[k] = parameters_(i, k);
+  return physical_inconsistency(RigidBodyParameters::from_standard(row));
+}
+
 void Model::set_rotor_inertia(const VectorIn& Ia) {
   require_length(Ia, n_, "Ia");
   Ia_ = Ia;

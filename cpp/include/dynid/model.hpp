@@ -45,6 +45,9 @@ class Model {
   const MatrixX& parameters() const { return parameters_; }
   void set_parameters(const Eigen::Ref<const MatrixX>& parameters);
   void set_link(int i, const RigidBodyParameters& body);
+  // Why link i (0-based) cannot exist as a rigid body ("" when it can): its standard parameters
+  // checked by physical_inconsistency (rigid_body.hpp). std::invalid_argument for i out of range.
+  std::string link_inconsistency(int i) const;
 
   // Drive terms (n each): rotor inertia reflected to the link side, viscous and Coulomb friction.
   const VectorX& rotor_inertia() const { return Ia_; }
