@@ -86,7 +86,8 @@ void bind_model(py::module_& m) {
       [](py::handle threads) { set_batch_threads(parse_count(threads, "threads")); },
       py::arg("threads"),
         "Use this many threads (each with its own workspace, GIL released) for batch calls of "
-        "at least 512 samples per thread. Default 1.");
+        "at least 512 samples per thread. Default 1. Threads the system refuses (memory, thread "
+        "limit) are skipped: the batch runs on those that start, at least the calling one.");
   m.def("get_threads", &batch_threads, "Threads used by batch calls.");
   m.def(
       "_last_batch_threads", [] { return last_batch_threads.load(); },

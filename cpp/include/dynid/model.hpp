@@ -1,6 +1,17 @@
-// The immutable description of a serial arm: its DH table, gravity, base and tool transforms,
-// standard inertial parameters (SPEC section 2) and drive terms. Algorithms read it through a
-// const reference; every per-call buffer lives in a Workspace, so one Model serves many threads.
+// The description of a serial arm: its DH table, gravity, base and tool transforms, standard
+// inertial parameters (SPEC section 2) and drive terms. Every per-call buffer lives in a
+// Workspace, so one Model serves many threads.
+//
+// Mutability and threads. A Model is a value: it is built from a DH table and completed with the
+// setters below (set_link, set_parameters, set_rotor_inertia, ...), each of which checks its
+// argument (std::invalid_argument naming it) and recomputes the derived quantities. The number
+// of joints never changes. The algorithms take it by const reference and only read it, so any
+// number of threads may evaluate the same Model at once, each with its own Workspace. A setter
+// is a write: calling one while another thread evaluates the same Model is a data race (nothing
+// inside is locked or atomic). To change a model that other threads are using, change a copy and
+// hand the copy over between calls (the Python binding does exactly this: a setter replaces a
+// std::shared_ptr<const Model>, so a batch already running keeps the model it started with). A
+// Workspace depends only on n() and stays valid across every setter.
 #pragma once
 
 #include <string>
@@ -57,7 +68,8 @@ class Model {
   void set_viscous_friction(const VectorIn& Fv);
   void set_coulomb_friction(const VectorIn& Fs);
 
-  // ---- derived quantities the algorithms use ----
+  // ---- derived quantities: the algorithms' view (unchecked index; its types are in
+  // dynid::detail and may change between releases) ----
   const detail::JointGeometry& joint(int i) const { return joints_[i]; }
   // Link i's parameters about the origin of its joint frame J_i.
   const RigidBodyParameters& body(int i) const { return bodies_[i]; }
