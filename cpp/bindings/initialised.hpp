@@ -17,7 +17,7 @@ template <class T>
 struct initialised_caster : pybind11::detail::type_caster_base<T> {
   bool load(pybind11::handle src, bool convert) {
     if (!pybind11::detail::type_caster_base<T>::load(src, convert)) return false;
-    const pybind11::detail::type_info* info = pybind11::detail::get_type_info(typeid(T));
+    const pybind11::detail::type_info* info = this->typeinfo;  // looked up once per caster
     if (info && PyObject_TypeCheck(src.ptr(), info->type)) {
       auto* instance = reinterpret_cast<pybind11::detail::instance*>(src.ptr());
       if (!instance->get_value_and_holder(info, false).holder_constructed()) {
