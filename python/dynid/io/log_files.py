@@ -4,7 +4,7 @@ A :class:`Log` holds time, joint positions and joint torques, with velocities an
 when the recording has them. Files are NPZ or CSV, laid out as in ``docs/data.md``; the
 FloBaRoID key names of the real KUKA LWR4+ recordings (``times``, ``positions``, ...) are read as
 they are. Preparing a log for identification (filtering, differentiation, decimation, dropping
-samples) is :mod:`dynid.preparation`; :func:`prepare_log` is re-exported here.
+samples) is :mod:`dynid.io.preparation`.
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import signal as sig
-from ._checks import real_array
+from .. import signal as sig
+from .._checks import real_array
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -395,7 +395,3 @@ def save_log(log: Log, path: PathLike) -> None:
     else:
         raise ValueError(f"path: unknown extension {path.suffix!r}; expected .npz or .csv")
 
-
-# Preparation builds on Log; imported last so that dynid.io.prepare_log stays where it was
-# (dynid.preparation imports Log from here).
-from .preparation import prepare_log  # noqa: F401

@@ -24,8 +24,8 @@ from typing import Any, Union
 
 import numpy as np
 
-from . import models
-from .robot import Robot
+from .. import models
+from ..robot import Robot
 
 PathLike = Union[str, Path]
 

@@ -11,7 +11,7 @@ frequency components. Following Swevers et al. (IEEE Trans. RA 13(5), 1997), joi
 so a_il, b_il are velocity amplitudes [rad/s or m/s]. This module holds the trajectory itself
 (:class:`FourierTrajectory`), its distance to the joint limits, the rest-to-rest projection and
 the condition number that measures its excitation; choosing the coefficients is
-:mod:`dynid.excitation_optimization` (re-exported here: :func:`optimize_excitation`).
+:mod:`dynid.excitation.optimization`.
 
 The condition number is that of the stacked base regressor with every column scaled to unit
 norm (here and in the optimiser): unscaled, it would mostly measure the units of the
@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._checks import real_array
-from .base_parameters import base_parameters
-from .robot import Robot
+from .._checks import real_array
+from ..base_parameters import base_parameters
+from ..robot import Robot
 
 #: Default velocity and acceleration limits for every joint [rad/s, rad/s^2]: about half the
 #: KUKA LWR4+'s rated joint speeds (110-180 deg/s), gentle enough for a first experiment.
@@ -310,15 +310,3 @@ def _qlim(value: ArrayLike, n: int) -> tuple[NDArray[np.float64], NDArray[np.flo
         raise ValueError(f"qlim: expected ({n}, 2) rows [lower, upper] with lower < upper")
     return limits[:, 0], limits[:, 1]
 
-
-# The optimiser builds on everything above; imported last so that the two modules can refer to
-# each other (dynid.excitation.optimize_excitation stays where it always was).
-from .excitation_optimization import (  # noqa: F401
-    CHECK_OVERSAMPLING,
-    CONSTRAINT_POINTS_PER_HARMONIC,
-    DEFAULT_POSITION_MARGIN,
-    TOLERANCE,
-    ExcitationResult,
-    _LogCondition,
-    optimize_excitation,
-)
