@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
     from .recursive import RecursiveLeastSquares
-    from .sim import VirtualController
+    from .sim import VirtualController, simulate
 
 #: Public name -> the module that defines it (imported on first access).
 _LAZY = {
@@ -75,6 +75,7 @@ _LAZY = {
     "validate_log": ".log_identification",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
+    "simulate": ".sim",
 }
 
 __all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .robot import Robot
+from ..robot import Robot
 
 Trajectory = Callable[[NDArray[np.float64]], tuple[NDArray, NDArray, NDArray]]
 
