@@ -16,15 +16,18 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
 
-void require(bool ok, const std::string& message) {
-  if (!ok) throw std::invalid_argument(message);
+// The message is built only on failure, so that a run allocates nothing once constructed.
+template <class Message>
+void require(bool ok, Message message) {
+  if (!ok) throw std::invalid_argument(message());
 }
 
 void check_rows(const RowMajorOut& block, Eigen::Index rows, int n, const char* name) {
-  require(block.rows() == rows && block.cols() == n,
-          std::string(name) + ": expected an output block of " + std::to_string(rows) + " x " +
-              std::to_string(n) + ", got " + std::to_string(block.rows()) + " x " +
-              std::to_string(block.cols()));
+  require(block.rows() == rows && block.cols() == n, [&] {
+    return std::string(name) + ": expected an output block of " + std::to_string(rows) + " x " +
+           std::to_string(n) + ", got " + std::to_string(block.rows()) + " x " +
+           std::to_string(block.cols());
+  });
 }
 
 }  // namespace
@@ -33,14 +36,15 @@ Simulator::Simulator(const Model& plant, const SimulationSettings& settings)
     : plant_(plant), settings_(settings), ws_(plant), rng_(settings.seed) {
   const SimulationSettings& s = settings;
   require(std::isfinite(s.dt) && s.dt > 0.0,
-          "dt: expected a positive control period, got " + std::to_string(s.dt));
-  require(s.substeps >= 1, "substeps: expected >= 1, got " + std::to_string(s.substeps));
+          [&] { return "dt: expected a positive control period, got " + std::to_string(s.dt); });
+  require(s.substeps >= 1,
+          [&] { return "substeps: expected >= 1, got " + std::to_string(s.substeps); });
   require(std::isfinite(s.coulomb_band) && s.coulomb_band >= 0.0,
-          "coulomb_band: expected a finite value >= 0, got " + std::to_string(s.coulomb_band));
+          [&] { return "coulomb_band: expected a finite value >= 0, got " + std::to_string(s.coulomb_band); });
   require(std::isfinite(s.torque_noise) && s.torque_noise >= 0.0,
-          "torque_noise: expected a finite value >= 0, got " + std::to_string(s.torque_noise));
+          [&] { return "torque_noise: expected a finite value >= 0, got " + std::to_string(s.torque_noise); });
   require(std::isfinite(s.encoder_counts) && s.encoder_counts >= 0.0,
-          "encoder_counts: expected a finite value >= 0, got " + std::to_string(s.encoder_counts));
+          [&] { return "encoder_counts: expected a finite value >= 0, got " + std::to_string(s.encoder_counts); });
   resolution_[0] = s.encoder_counts > 0.0 ? kTwoPi / s.encoder_counts : 0.0;
   resolution_[1] = s.encoder_counts > 0.0 ? 1.0 / s.encoder_counts : 0.0;
   const int n = plant.n();
@@ -129,11 +133,14 @@ void Simulator::measure(int k) {
 void Simulator::run(Controller& controller, const VectorIn& q0, const VectorIn& qd0, int periods,
                     SimulationOutput& out) {
   const int n = plant_.n();
-  require(q0.size() == n, "q0: expected " + std::to_string(n) + " values, got " +
-                              std::to_string(q0.size()));
-  require(qd0.size() == n, "qd0: expected " + std::to_string(n) + " values, got " +
-                               std::to_string(qd0.size()));
-  require(periods >= 1, "periods: expected >= 1, got " + std::to_string(periods));
+  require(q0.size() == n,
+          [&] { return "q0: expected " + std::to_string(n) + " values, got " +
+                              std::to_string(q0.size()); });
+  require(qd0.size() == n,
+          [&] { return "qd0: expected " + std::to_string(n) + " values, got " +
+                               std::to_string(qd0.size()); });
+  require(periods >= 1,
+          [&] { return "periods: expected >= 1, got " + std::to_string(periods); });
   const Eigen::Index rows = static_cast<Eigen::Index>(periods) + 1;
   check_rows(out.q, rows, n, "q");
   check_rows(out.qd, rows, n, "qd");
