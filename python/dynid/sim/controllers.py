@@ -82,33 +82,34 @@ def gains(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:
 
 
 def sample_reference(
-    reference: Reference, t: NDArray[np.float64], n: int
+    reference: Reference, t: NDArray[np.float64], n: int, name: str = "reference"
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """The desired (q_d, qd_d, qdd_d) at the control instants ``t``, each (len(t), n)."""
+    """The desired (q_d, qd_d, qdd_d) at the control instants ``t``, each (len(t), n);
+    ``name`` is the argument named in errors."""
     rows = len(t)
     if callable(reference):
         values = reference(t.copy())
-        source = "reference(t)"
+        source = f"{name}(t)"
     else:
         values = reference
-        source = "reference"
+        source = name
     if isinstance(values, tuple):
         if len(values) != 3:
-            raise ValueError(f"reference: expected (q_d, qd_d, qdd_d), got a tuple of {len(values)}")
+            raise ValueError(f"{name}: expected (q_d, qd_d, qdd_d), got a tuple of {len(values)}")
         out = []
         for label, value in zip(("q_d", "qd_d", "qdd_d"), values):
-            array = real_array(value, f"reference ({label})")
+            array = real_array(value, f"{name} ({label})")
             if array.shape != (rows, n):
                 raise ValueError(
-                    f"reference: expected {source} {label} of shape ({rows}, {n}) (one row per "
+                    f"{name}: expected {source} {label} of shape ({rows}, {n}) (one row per "
                     f"control instant k dt, k = 0..{rows - 1}), got shape {array.shape}"
                 )
             out.append(np.ascontiguousarray(array))
         return out[0], out[1], out[2]
-    setpoint = real_array(values, "reference")
+    setpoint = real_array(values, name)
     if setpoint.shape != (n,):
         raise ValueError(
-            f"reference: expected a setpoint of shape ({n},), a tuple (q_d, qd_d, qdd_d) of "
+            f"{name}: expected a setpoint of shape ({n},), a tuple (q_d, qd_d, qdd_d) of "
             f"({rows}, {n}) arrays or a callable of t, got shape {setpoint.shape}"
         )
     zeros = np.zeros((rows, n))

@@ -176,7 +176,7 @@ class VirtualController:
             raise ValueError(f"rate: expected a sampling rate > 0, got {rate!r}")
         periods = max(round(duration * rate), 1)
         t = np.arange(periods + 1) / rate
-        q_d, qd_d, qdd_d = sample_reference(trajectory, t, self.robot.n)
+        q_d, qd_d, qdd_d = sample_reference(trajectory, t, self.robot.n, "trajectory")
         if gains is None:
             inertia = np.diag(self.plant.mass_matrix(q_d[0]))
             kp, kd = TRACKING_BANDWIDTH**2 * inertia, 2.0 * TRACKING_BANDWIDTH * inertia
