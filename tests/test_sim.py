@@ -160,7 +160,9 @@ def test_link_friction_appears_in_tau_j():
     robot = dynid.models.kuka_lwr4()
     rho = np.array([0.1, 0.2, 0.3, 0.25, 0.5, 1.0, 0.0])
     plain = VirtualController(robot).track(paper_validation_trajectory, 1.0, 500.0)
-    rubbing = VirtualController(robot, link_friction=rho).track(paper_validation_trajectory, 1.0, 500.0)
+    rubbing = VirtualController(robot, link_friction=rho).track(
+        paper_validation_trajectory, 1.0, 500.0
+    )
     qd = plain.motion.qd
     expected = rho * (robot.Fv * qd + robot.Fs * np.tanh(qd / COULOMB_BAND))
     np.testing.assert_array_equal(rubbing.motion.q, plain.motion.q)

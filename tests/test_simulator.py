@@ -255,7 +255,8 @@ def test_applied_torque_is_the_plant_equation_and_noise_is_seeded(lwr):
         return plant.rnea(run.q, run.qd, run.qdd) + plant_friction(lwr, run.qd, 1e-3)
 
     clean = simulate(lwr, Q0, QD0, 2.0, law)
-    np.testing.assert_allclose(applied(clean), clean.tau, rtol=0, atol=1e-9 * np.abs(clean.tau).max())
+    np.testing.assert_allclose(applied(clean), clean.tau, rtol=0,
+                               atol=1e-9 * np.abs(clean.tau).max())
     noisy = simulate(lwr, Q0, QD0, 2.0, law, torque_noise=0.05, seed=3)
     noise = applied(noisy) - noisy.tau
     assert np.std(noise) == pytest.approx(0.05, rel=0.03)

@@ -105,7 +105,8 @@ void bind_simulator(py::module_& m) {
               throw py::value_error("model: expected the controller's Robot with " +
                                     std::to_string(n) + " joints");
             if (kind == "pd_gravity")
-              controller = std::make_unique<PDGravityController>(*controller_model, Kp, Kd, reference);
+              controller =
+                  std::make_unique<PDGravityController>(*controller_model, Kp, Kd, reference);
             else
               controller =
                   std::make_unique<ComputedTorqueController>(*controller_model, Kp, Kd, reference);
@@ -115,9 +116,9 @@ void bind_simulator(py::module_& m) {
         }
 
         Simulator simulator(*plant_model, settings);
-        py::array_t<double> q({rows, static_cast<py::ssize_t>(n)}), qd({rows, static_cast<py::ssize_t>(n)}),
-            qdd({rows, static_cast<py::ssize_t>(n)}), tau({rows, static_cast<py::ssize_t>(n)});
-        py::array_t<double> q_measured({record_measured ? rows : py::ssize_t{0}, static_cast<py::ssize_t>(n)});
+        const auto cols = static_cast<py::ssize_t>(n);
+        py::array_t<double> q({rows, cols}), qd({rows, cols}), qdd({rows, cols}), tau({rows, cols});
+        py::array_t<double> q_measured({record_measured ? rows : py::ssize_t{0}, cols});
         SimulationOutput out{RowMajorMap(q.mutable_data(), rows, n),
                              RowMajorMap(qd.mutable_data(), rows, n),
                              RowMajorMap(qdd.mutable_data(), rows, n),

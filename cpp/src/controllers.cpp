@@ -11,10 +11,10 @@ namespace {
 
 using ConstRow = Eigen::Map<const VectorX>;
 
-void check_size(const VectorIn& v, Eigen::Index n, const char* name) {
-  if (v.size() != n)
+void check_size(Eigen::Index size, Eigen::Index n, const char* name) {
+  if (size != n)
     throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(n) +
-                                " values, got " + std::to_string(v.size()));
+                                " values, got " + std::to_string(size));
 }
 
 void check_reference(const ReferenceTrajectory& r, int n) {
@@ -35,23 +35,24 @@ void check_model(const Model& model, Eigen::Index n) {
 PDController::PDController(const VectorIn& kp, const VectorIn& kd,
                            const ReferenceTrajectory& reference)
     : kp_(kp), kd_(kd), e_(kp.size()), ed_(kp.size()), reference_(reference) {
-  check_size(kd, kp.size(), "kd");
+  check_size(kd.size(), kp.size(), "kd");
   check_reference(reference, static_cast<int>(kp.size()));
 }
 
-void PDController::errors(int k, const VectorIn& q, const VectorIn& qd) {
+void PDController::errors(int k, const VectorIn& q, const VectorIn& qd, Eigen::Index tau_size) {
   const int n = reference_.n;
   if (k < 0 || k >= reference_.samples)
     throw std::out_of_range("reference: sample " + std::to_string(k) + " requested, it has " +
                             std::to_string(reference_.samples));
-  check_size(q, n, "q");
-  check_size(qd, n, "qd");
+  check_size(q.size(), n, "q");
+  check_size(qd.size(), n, "qd");
+  check_size(tau_size, n, "tau");
   e_ = ConstRow(reference_.q + static_cast<std::ptrdiff_t>(k) * n, n) - q;
   ed_ = ConstRow(reference_.qd + static_cast<std::ptrdiff_t>(k) * n, n) - qd;
 }
 
 void PDController::command(int k, double, const VectorIn& q, const VectorIn& qd, VectorOut tau) {
-  errors(k, q, qd);
+  errors(k, q, qd, tau.size());
   tau = kp_.cwiseProduct(e_) + kd_.cwiseProduct(ed_);
 }
 
@@ -63,7 +64,7 @@ PDGravityController::PDGravityController(const Model& model, const VectorIn& kp,
 
 void PDGravityController::command(int k, double, const VectorIn& q, const VectorIn& qd,
                                   VectorOut tau) {
-  errors(k, q, qd);
+  errors(k, q, qd, tau.size());
   gravity(model_, ws_, q, g_);
   tau = kp_.cwiseProduct(e_) + kd_.cwiseProduct(ed_) + g_;
 }
@@ -77,7 +78,7 @@ ComputedTorqueController::ComputedTorqueController(const Model& model, const Vec
 
 void ComputedTorqueController::command(int k, double, const VectorIn& q, const VectorIn& qd,
                                        VectorOut tau) {
-  errors(k, q, qd);
+  errors(k, q, qd, tau.size());
   const int n = reference_.n;
   // The outer loop's acceleration command, then inverse dynamics of the model at (q, qd, v).
   v_ = ConstRow(reference_.qdd + static_cast<std::ptrdiff_t>(k) * n, n) +

@@ -16,6 +16,8 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
 
+std::string num(double x) { return std::to_string(x); }
+
 // The message is built only on failure, so that a run allocates nothing once constructed.
 template <class Message>
 void require(bool ok, Message message) {
@@ -40,11 +42,11 @@ Simulator::Simulator(const Model& plant, const SimulationSettings& settings)
   require(s.substeps >= 1,
           [&] { return "substeps: expected >= 1, got " + std::to_string(s.substeps); });
   require(std::isfinite(s.coulomb_band) && s.coulomb_band >= 0.0,
-          [&] { return "coulomb_band: expected a finite value >= 0, got " + std::to_string(s.coulomb_band); });
+          [&] { return "coulomb_band: expected a finite value >= 0, got " + num(s.coulomb_band); });
   require(std::isfinite(s.torque_noise) && s.torque_noise >= 0.0,
-          [&] { return "torque_noise: expected a finite value >= 0, got " + std::to_string(s.torque_noise); });
+          [&] { return "torque_noise: expected a finite value >= 0, got " + num(s.torque_noise); });
   require(std::isfinite(s.encoder_counts) && s.encoder_counts >= 0.0,
-          [&] { return "encoder_counts: expected a finite value >= 0, got " + std::to_string(s.encoder_counts); });
+          [&] { return "encoder_counts: expected a value >= 0, got " + num(s.encoder_counts); });
   resolution_[0] = s.encoder_counts > 0.0 ? kTwoPi / s.encoder_counts : 0.0;
   resolution_[1] = s.encoder_counts > 0.0 ? 1.0 / s.encoder_counts : 0.0;
   const int n = plant.n();

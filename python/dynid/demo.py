@@ -40,10 +40,10 @@ DEMO_MIN_TRAIN = 3
 #: Fewest validation configurations: the errors need at least one sample.
 DEMO_MIN_VALIDATION = 1
 
-#: Fraction of the joint friction (the model's Fv, Fs) acting between the torque sensor and the link:
-#: it appears in tau_J but not in the identified link model. A quarter of the LWR model's friction
-#: gives TVE maximum errors of 0.08-0.43 N m (0.39 N m on J2), the size of the paper's Table III
-#: (0.37 N m on J2).
+#: Fraction of the joint friction (the model's Fv, Fs) acting between the torque sensor and the
+#: link: it appears in tau_J but not in the identified link model. A quarter of the LWR model's
+#: friction gives TVE maximum errors of 0.08-0.43 N m (0.39 N m on J2), the size of the paper's
+#: Table III (0.37 N m on J2).
 LINK_FRICTION = 0.25
 
 TIP_MASS = 0.25  # kg, the paper's symmetric steel tip

@@ -33,12 +33,14 @@ Model lwr_like() {
   const double alpha[kJoints] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0.0};
   const double d[kJoints] = {0.0, 0.0, 0.4, 0.0, 0.39, 0.0, 0.0};
   std::vector<DHRow> rows;
-  for (int i = 0; i < kJoints; ++i) rows.push_back(DHRow{0.0, alpha[i], d[i], 0.0, JointType::Revolute});
+  for (int i = 0; i < kJoints; ++i)
+    rows.push_back(DHRow{0.0, alpha[i], d[i], 0.0, JointType::Revolute});
   Model model(rows, Convention::Standard);
   for (int i = 0; i < kJoints; ++i) {
     const double mass = 3.0 - 0.35 * i;
     const Vector3 com(0.002 * i, -0.03 + 0.01 * i, 0.05 - 0.004 * i);
-    const Matrix3 inertia = Vector3(0.02 - 0.002 * i, 0.018 - 0.002 * i, 0.01 - 0.001 * i).asDiagonal();
+    const Matrix3 inertia =
+        Vector3(0.02 - 0.002 * i, 0.018 - 0.002 * i, 0.01 - 0.001 * i).asDiagonal();
     model.set_link(i, RigidBodyParameters::from_physical(mass, com, inertia));
   }
   VectorX Ia(kJoints), Fv(kJoints), Fs(kJoints);
@@ -126,7 +128,8 @@ int main() {
   // Computed torque with the plant's model tracks eq. (33): error below 0.01 rad (noise 0.05 N m,
   // encoder 2^20 counts per revolution).
   double tracking = 0.0;
-  for (int j = 0; j < rows * kJoints; ++j) tracking = std::fmax(tracking, std::fabs(buffers.q[j] - q_d[j]));
+  for (int j = 0; j < rows * kJoints; ++j)
+    tracking = std::fmax(tracking, std::fabs(buffers.q[j] - q_d[j]));
   std::printf("computed_torque_max_tracking_error=%.3e\n", tracking);
 
   // Free motion without friction: RK4 conserves T + U to 1e-9 of the largest kinetic energy.
@@ -138,7 +141,8 @@ int main() {
   PDController none(zero, zero, reference);
   Buffers free_buffers(rows);
   SimulationOutput free_out = free_buffers.output(rows);
-  const VectorX q_start = VectorX::Constant(kJoints, 0.3), qd_start = VectorX::Constant(kJoints, 0.5);
+  const VectorX q_start = VectorX::Constant(kJoints, 0.3);
+  const VectorX qd_start = VectorX::Constant(kJoints, 0.5);
   counting = true;
   free_sim.run(none, q_start, qd_start, kPeriods, free_out);
   counting = false;

@@ -1,7 +1,7 @@
 // Built-in joint-space control laws for the Simulator (notes, "Use of the dynamic model"). Each
 // controller reads the desired trajectory sampled at the control instants and, where it uses a
-// model, evaluates its own Model (possibly not the plant's, to show the effect of a mismatch) in its
-// own Workspace: a command allocates nothing.
+// model, evaluates its own Model (possibly not the plant's, to show the effect of a mismatch) in
+// its own Workspace: a command allocates nothing.
 #pragma once
 
 #include "dynid/model.hpp"
@@ -28,8 +28,9 @@ class PDController : public Controller {
   void command(int k, double t, const VectorIn& q, const VectorIn& qd, VectorOut tau) override;
 
  protected:
-  // e = q_d - q, ed = qd_d - qd at sample k into e_, ed_; throws std::out_of_range past the end.
-  void errors(int k, const VectorIn& q, const VectorIn& qd);
+  // e = q_d - q, ed = qd_d - qd at sample k into e_, ed_, after checking the sizes of q, qd and
+  // tau (std::invalid_argument naming them); throws std::out_of_range past the reference's end.
+  void errors(int k, const VectorIn& q, const VectorIn& qd, Eigen::Index tau_size);
 
   VectorX kp_, kd_, e_, ed_;
   ReferenceTrajectory reference_;

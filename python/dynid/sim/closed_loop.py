@@ -94,7 +94,9 @@ def simulate(
         Seed of the torque noise.
     """
     if not isinstance(robot, _core.Model):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+        raise ValueError(  # noqa: TRY004 -- SPEC 2: a ValueError naming the argument
+            f"robot: expected a dynid.Robot, got {type(robot).__name__}"
+        )
     n = robot.n
     q0 = _vector(q0, "q0", n)
     qd0 = np.zeros(n) if qd0 is None else _vector(qd0, "qd0", n)
@@ -110,10 +112,11 @@ def simulate(
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected 'rk4' or 'euler' (semi-implicit Euler), got {method!r}")
     if not isinstance(friction, (bool, np.bool_)):
-        raise ValueError(f"friction: expected True or False, got {friction!r}")
+        raise ValueError(f"friction: expected True or False, got {friction!r}")  # noqa: TRY004
     coulomb_band = _number(coulomb_band, "coulomb_band", positive=False)
     torque_noise = _number(torque_noise, "torque_noise", positive=False)
-    counts = 0.0 if encoder_counts is None else _number(encoder_counts, "encoder_counts", positive=True)
+    counts = (0.0 if encoder_counts is None
+              else _number(encoder_counts, "encoder_counts", positive=True))
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
 
@@ -137,7 +140,9 @@ def plant_friction(robot: Robot, qd: ArrayLike, coulomb_band: float = 1e-3) -> N
     return robot.Fv * qd + robot.Fs * coulomb
 
 
-def _controller_arguments(controller: Controller | None, robot: Robot, t: NDArray, n: int) -> dict[str, Any]:
+def _controller_arguments(
+    controller: Controller | None, robot: Robot, t: NDArray, n: int
+) -> dict[str, Any]:
     """The keyword arguments of _core._simulate that describe the control law."""
     law: dict[str, Any] = {"model": None, "kp": None, "kd": None, "q_d": None, "qd_d": None,
                            "qdd_d": None, "function": None}
@@ -173,7 +178,7 @@ def _vector(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:
 def _number(value: Any, name: str, *, positive: bool) -> float:
     bound = "> 0" if positive else ">= 0"
     if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name}: expected a finite number {bound}, got {value!r}")
+        raise ValueError(f"{name}: expected a finite number {bound}, got {value!r}")  # noqa: TRY004
     try:
         number = float(value)
     except (TypeError, ValueError):

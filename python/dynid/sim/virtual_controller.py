@@ -124,7 +124,9 @@ class VirtualController:
                 f"got {link_friction!r}"
             )
         if encoder_counts is not None and not (np.isfinite(encoder_counts) and encoder_counts > 0):
-            raise ValueError(f"encoder_counts: expected a positive count or None, got {encoder_counts!r}")
+            raise ValueError(
+                f"encoder_counts: expected a positive count or None, got {encoder_counts!r}"
+            )
         self.plant = robot.copy()
         self.robot = robot.rigid_body()
         self.model_noise = float(model_noise)
@@ -183,7 +185,8 @@ class VirtualController:
         else:
             if not (isinstance(gains, tuple) and len(gains) == 2):
                 raise ValueError(f"gains: expected a tuple (kp, kd), got {gains!r}")
-            kp, kd = check_gains(gains[0], "kp", self.robot.n), check_gains(gains[1], "kd", self.robot.n)
+            kp = check_gains(gains[0], "kp", self.robot.n)
+            kd = check_gains(gains[1], "kd", self.robot.n)
         if substeps is None:
             substeps = stable_substeps(self.plant, q_d[0], 1.0 / rate, COULOMB_BAND, kd)
         run = simulate(
