@@ -13,10 +13,11 @@ x axis of the frame between two consecutive axes lies along their common normal.
   origin (standard) or through the point where the previous x axis meets axis i (modified), so
   that d_i = 0; coincident axes keep the previous x (theta = 0).
 - Frame 0 (both conventions): z along u_1, origin at the foot of the base origin on axis 1, x
-  along the base x axis projected on the plane normal to u_1 (its y axis if x is along u_1): the
+  along the base x axis projected on the plane normal to u_1 (its y axis if x is nearly along
+  u_1): the
   base transform is the identity when axis 1 is the base z axis, as on most arms.
 - Last frame: z along u_n, origin at the foot of the tip origin on axis n, x along the tip's x
-  projected (tip y if x is along u_n): the tool transform is a pure translation, often zero,
+  projected (tip y if x is nearly along u_n): the tool transform is a pure translation, often zero,
   when the tip's z is the last axis.
 
 Where the sign of x is free (non-parallel axes, the normal between parallel ones) it is taken
@@ -67,7 +68,7 @@ def dh_frames(points: Array, axes: Array, tip: Array, convention: str) -> tuple[
     frame[:3, 3] = _foot(np.zeros(3), points[0], axes[0])
     base = frame.copy()
     step = _standard_rows if convention == "standard" else _modified_rows
-    return np.array(list(step(base, points, axes, tip))), base
+    return np.array(list(step(base, points, axes, tip))) + 0.0, base  # + 0.0: no -0.0 printed
 
 
 def _standard_rows(frame: Array, points: Array, axes: Array, tip: Array):

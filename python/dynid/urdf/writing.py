@@ -167,7 +167,7 @@ def _rx_tx(row: Array) -> Array:
 
 
 def _number(value: float) -> str:
-    return repr(float(value))  # shortest text that reads back to the same double
+    return repr(float(value) + 0.0)  # shortest text reading back to the same double; no -0.0
 
 
 def _vector(values: Array) -> str:
