@@ -14,11 +14,10 @@ x axis of the frame between two consecutive axes lies along their common normal.
   that d_i = 0; coincident axes keep the previous x (theta = 0).
 - Frame 0 (both conventions): z along u_1, origin at the foot of the base origin on axis 1, x
   along the base x axis projected on the plane normal to u_1 (its y axis if x is nearly along
-  u_1): the
-  base transform is the identity when axis 1 is the base z axis, as on most arms.
+  u_1): the base transform is the identity when axis 1 is the base z axis, as on most arms.
 - Last frame: z along u_n, origin at the foot of the tip origin on axis n, x along the tip's x
-  projected (tip y if x is nearly along u_n): the tool transform is a pure translation, often zero,
-  when the tip's z is the last axis.
+  projected (tip y if x is nearly along u_n): the tool transform is a pure translation, often
+  zero, when the tip's z is the last axis.
 
 Where the sign of x is free (non-parallel axes, the normal between parallel ones) it is taken
 so that x makes an acute angle with the previous x: theta offsets stay small.
