@@ -108,6 +108,15 @@ def read_tree(urdf: Union[str, Path]) -> UrdfTree:
     if len(roots) != 1:
         raise ValueError(f"urdf: expected one root link (a link that is no joint's child), got "
                          f"{len(roots)}: {roots[:5]} (a cycle or several trees)")
+    reached, stack = {roots[0]}, [roots[0]]
+    while stack:
+        for joint in tree.children(stack.pop()):
+            reached.add(joint.child)
+            stack.append(joint.child)
+    if len(reached) != len(links):
+        lost = [name for name in links if name not in reached]
+        raise ValueError(f"urdf: links {lost[:5]} are not connected to the root {roots[0]!r} "
+                         "(a cycle of joints)")
     return tree
 
 
@@ -117,8 +126,10 @@ def serial_chain(tree: UrdfTree, base_link: str | None, tip_link: str | None) ->
     base = tree.root if base_link is None else _link_name(tree, base_link, "base_link")
     if tip_link is None:
         leaves = _moving_leaves(tree, base)
+        if not leaves:
+            raise ValueError(f"urdf: no movable joint below {base!r}")
         if len(leaves) != 1:
-            found = ", ".join(repr(leaf) for leaf in leaves) or "none"
+            found = ", ".join(repr(leaf) for leaf in leaves)
             raise ValueError(f"tip_link: the tree below {base!r} has {len(leaves)} leaves reached "
                              f"through movable joints ({found}); pass tip_link= to choose one")
         tip = leaves[0]
