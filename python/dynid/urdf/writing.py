@@ -131,18 +131,17 @@ def rpy(rotation: Array) -> Array:
 
 def _physical(params: Array, i: int) -> tuple[float, Array, Array]:
     mass = float(params[0])
-    if not mass > 0.0:
-        raise ValueError(f"robot: link {i + 1} has mass {mass}; a URDF link needs m > 0 "
-                         "(physically consistent parameters)")
-    com = np.asarray(params[1:4]) / mass
+    com = np.asarray(params[1:4]) / mass if mass > 0.0 else np.zeros(3)
     about_origin = np.array([[params[4], params[5], params[6]],
                              [params[5], params[7], params[8]],
                              [params[6], params[8], params[9]]])
     inertia = about_origin - mass * ((com @ com) * np.eye(3) - np.outer(com, com))
-    why = _core.physical_inconsistency(mass, inertia)
+    why = f"mass {mass} is not positive" if not mass > 0.0 else _core.physical_inconsistency(
+        mass, inertia)
     if why:
-        raise ValueError(f"robot: link {i + 1} is not physically consistent ({why}); URDF needs "
-                         "a positive definite inertia about the centre of mass")
+        raise ValueError(f"robot: link {i + 1} is not physically consistent ({why}); a URDF link "
+                         "needs m > 0 and a positive definite inertia about its centre of mass "
+                         "that satisfies the triangle inequalities")
     return mass, com, inertia
 
 
