@@ -13,11 +13,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from importlib.metadata import distribution
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 DATA = Path(__file__).parent / "data" / "urdf"
+TOL = 1e-10  # relative to the largest entry of each result (the maths is exact)
 
 
 def example_robot_data(relative: str) -> Path:
@@ -91,3 +93,20 @@ def reference(text: str, base_link: str | None, tip_link: str) -> Reference:
 def relative_error(actual: np.ndarray, expected: np.ndarray) -> float:
     """max |actual - expected| / max |expected|: the error relative to the result's scale."""
     return float(np.max(np.abs(actual - expected)) / max(1e-12, float(np.max(np.abs(expected)))))
+
+
+def assert_matches_pinocchio(robot: Any, text: str, base_link, tip_link, seed=0,
+                             samples=8) -> None:
+    """rnea, M, g (rigid body: Pinocchio has no friction) and the tip pose of ``robot`` equal
+    Pinocchio's on ``text`` at random q, to TOL relative."""
+    ref = reference(text, base_link, tip_link)
+    assert ref.model.nv == robot.n
+    rigid = robot.rigid_body()  # Pinocchio's rnea has no friction
+    rigid.gravity_vector = ref.gravity
+    rng = np.random.default_rng(seed)
+    for _ in range(samples):
+        q, qd, qdd = rng.uniform(-np.pi, np.pi, (3, robot.n))
+        assert relative_error(rigid.rnea(q, qd, qdd), ref.rnea(q, qd, qdd)) < TOL
+        assert relative_error(rigid.mass_matrix(q), ref.mass_matrix(q)) < TOL
+        assert relative_error(rigid.gravity(q), ref.gravity_torques(q)) < TOL
+        assert relative_error(robot.fkine(q), ref.tip_pose(q)) < TOL

@@ -18,9 +18,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from dynid.urdf.reading import standard_parameters
-from pinocchio_urdf import DATA, example_robot_data, reference, relative_error
+from pinocchio_urdf import (
+    DATA,
+    assert_matches_pinocchio,
+    example_robot_data,
+    reference,
+)
 
-TOL = 1e-10  # relative to the largest entry of each result
 CONVENTIONS = ("standard", "modified")
 
 # (file, base_link, tip_link): the real arms of issue 10
@@ -46,21 +50,6 @@ def _text(path: Path | str) -> str:
     if isinstance(path, str):
         path = example_robot_data(path)
     return Path(path).read_text(encoding="utf-8")
-
-
-def assert_matches_pinocchio(robot: dynid.Robot, text: str, base_link, tip_link, seed=0,
-                             samples=8) -> None:
-    ref = reference(text, base_link, tip_link)
-    assert ref.model.nv == robot.n
-    rigid = robot.rigid_body()  # Pinocchio's rnea has no friction
-    rigid.gravity_vector = ref.gravity
-    rng = np.random.default_rng(seed)
-    for _ in range(samples):
-        q, qd, qdd = rng.uniform(-np.pi, np.pi, (3, robot.n))
-        assert relative_error(rigid.rnea(q, qd, qdd), ref.rnea(q, qd, qdd)) < TOL
-        assert relative_error(rigid.mass_matrix(q), ref.mass_matrix(q)) < TOL
-        assert relative_error(rigid.gravity(q), ref.gravity_torques(q)) < TOL
-        assert relative_error(robot.fkine(q), ref.tip_pose(q)) < TOL
 
 
 @pytest.mark.parametrize("convention", CONVENTIONS)
@@ -216,9 +205,9 @@ def generated_urdf(seed: int) -> tuple[str, str]:
     rng = np.random.default_rng(seed)
     parts = ['<robot name="generated">', '<link name="world"/>',
              f'<link name="base">{_inertial(rng)}</link>',
-             f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
+             (f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
              f'<origin xyz="{_vec(rng.uniform(-1, 1, 3))}" rpy="{_vec(rng.uniform(-3, 3, 3))}"/>'
-             '</joint>']
+             '</joint>')]
     parent, previous_axis = "base", None
     for k in range(int(rng.integers(2, 7))):
         kind = rng.choice(["revolute", "continuous", "prismatic"], p=[0.5, 0.2, 0.3])
@@ -233,30 +222,30 @@ def generated_urdf(seed: int) -> tuple[str, str]:
             xyz, rpy, axis = rng.uniform(-0.4, 0.4) * previous_axis, np.zeros(3), previous_axis
         if relation == "skew" and rng.random() < 0.4:  # a fixed link in between (merged)
             parts += [f'<link name="fixed{k}">{_inertial(rng)}</link>',
-                      f'<joint name="fix{k}" type="fixed"><parent link="{parent}"/>'
+                      (f'<joint name="fix{k}" type="fixed"><parent link="{parent}"/>'
                       f'<child link="fixed{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
-                      f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>']
+                      f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>')]
             parent = f"fixed{k}"
         limit = '<limit lower="-1.5" upper="2.5" effort="1" velocity="1"/>'
         parts += [f'<link name="link{k}">{_inertial(rng)}</link>',
-                  f'<joint name="joint{k}" type="{kind}"><parent link="{parent}"/>'
+                  (f'<joint name="joint{k}" type="{kind}"><parent link="{parent}"/>'
                   f'<child link="link{k}"/><origin xyz="{_vec(xyz)}" rpy="{_vec(rpy)}"/>'
                   f'<axis xyz="{_vec(axis)}"/>{limit if kind != "continuous" else ""}'
                   f'<dynamics damping="{float(rng.uniform(0, 2))!r}" '
                   f'friction="{float(rng.uniform(0, 1))!r}"/>'
-                  '</joint>']
+                  '</joint>')]
         if rng.random() < 0.3:  # a branch: a leaf held at 0 (revolute) or rigidly fixed
             branch = rng.choice(["revolute", "fixed"])
             parts += [f'<link name="branch{k}">{_inertial(rng)}</link>',
-                      f'<joint name="branch_joint{k}" type="{branch}"><parent link="link{k}"/>'
+                      (f'<joint name="branch_joint{k}" type="{branch}"><parent link="link{k}"/>'
                       f'<child link="branch{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}"/>'
-                      f'<axis xyz="{_vec(_unit(rng))}"/>{limit}</joint>']
+                      f'<axis xyz="{_vec(_unit(rng))}"/>{limit}</joint>')]
         parent, previous_axis = f"link{k}", axis
     for k in range(int(rng.integers(0, 3))):  # fixed chain after the last joint -> tool
         parts += [f'<link name="flange{k}">{_inertial(rng)}</link>',
-                  f'<joint name="flange_joint{k}" type="fixed"><parent link="{parent}"/>'
+                  (f'<joint name="flange_joint{k}" type="fixed"><parent link="{parent}"/>'
                   f'<child link="flange{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
-                  f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>']
+                  f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>')]
         parent = f"flange{k}"
     return "\n".join([*parts, "</robot>"]), parent
 

@@ -15,7 +15,7 @@ import numpy as np
 from . import _core
 from .robot import Robot
 
-__all__ = ["kuka_lwr4", "panda", "planar_2r", "puma560", "ur10", "ur5"]
+__all__ = ["kuka_lwr4", "panda", "planar_2r", "puma560", "ur5", "ur10"]
 
 _DEG = np.pi / 180.0
 

@@ -13,7 +13,6 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -73,7 +72,7 @@ def rpy_matrix(roll: float, pitch: float, yaw: float) -> Array:
     ])  # fmt: skip
 
 
-def read_tree(urdf: Union[str, Path]) -> UrdfTree:
+def read_tree(urdf: str | Path) -> UrdfTree:
     """Parse a URDF given as a path or as the XML text. ValueError for malformed XML or content
     (naming the element); FileNotFoundError for a path that does not exist."""
     text = _text(urdf)
@@ -175,7 +174,7 @@ def _link_name(tree: UrdfTree, name: object, argument: str) -> str:
     return name
 
 
-def _text(urdf: Union[str, Path]) -> str:
+def _text(urdf: str | Path) -> str:
     if isinstance(urdf, Path) or (isinstance(urdf, str) and not urdf.lstrip().startswith("<")):
         path = Path(urdf)
         if not path.is_file():

@@ -29,7 +29,7 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -94,11 +94,12 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def write_urdf(text: str, path: Union[str, Path], overwrite: bool = False) -> Path:
+def write_urdf(text: str, path: str | Path, overwrite: bool = False) -> Path:
     """Write ``text`` to ``path`` through a temporary file and a rename (the file is whole or
     absent). An existing file is a ValueError unless ``overwrite``."""
     if not isinstance(overwrite, bool):
-        raise ValueError(f"overwrite: expected True or False, got {overwrite!r}")
+        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+            f"overwrite: expected True or False, got {overwrite!r}")
     if not isinstance(path, (str, Path)) or not str(path).strip():
         raise ValueError(f"path: expected a file path, got {path!r}")
     target = Path(path)
