@@ -100,6 +100,15 @@ def test_malformed_urdf_is_a_value_error(text: str, message: str) -> None:
         dynid.Robot.from_urdf(text)
 
 
+def test_file_encoding_and_declaration_are_honoured(tmp_path: Path) -> None:
+    text = chain(*SERIAL).replace('name="t"', 'name="bras articulé"', 1)
+    path = tmp_path / "latin1.urdf"
+    path.write_bytes(b'<?xml version="1.0" encoding="iso-8859-1"?>\n' + text.encode("latin-1"))
+    assert dynid.Robot.from_urdf(path).name == "bras articulé"
+    declared = '<?xml version="1.0" encoding="utf-8"?>\n' + text
+    assert dynid.Robot.from_urdf(declared).name == "bras articulé"
+
+
 def test_bad_arguments_are_named(tmp_path: Path) -> None:
     text = chain(*SERIAL)
     with pytest.raises(ValueError, match="base_link: no link named 'nope'"):

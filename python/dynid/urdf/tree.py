@@ -174,12 +174,12 @@ def _link_name(tree: UrdfTree, name: object, argument: str) -> str:
     return name
 
 
-def _text(urdf: str | Path) -> str:
+def _text(urdf: str | Path) -> str | bytes:
     if isinstance(urdf, Path) or (isinstance(urdf, str) and not urdf.lstrip().startswith("<")):
         path = Path(urdf)
         if not path.is_file():
             raise FileNotFoundError(f"urdf: no such file: {path}")
-        return path.read_text(encoding="utf-8")
+        return path.read_bytes()  # the parser honours the file's encoding declaration
     if isinstance(urdf, str):
         return urdf
     raise ValueError(f"urdf: expected a path or the URDF text, got {type(urdf).__name__}")
