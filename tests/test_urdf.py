@@ -23,6 +23,7 @@ from pinocchio_urdf import (
     assert_matches_pinocchio,
     example_robot_data,
     reference,
+    relative_error,
 )
 
 CONVENTIONS = ("standard", "modified")
@@ -291,3 +292,51 @@ def test_hand_made_skew_axis_and_prismatic_joint() -> None:
         np.testing.assert_array_equal(robot.Fv, [0, 3.5, 0])
         np.testing.assert_array_equal(robot.Fs, [0, 1.25, 0])
         assert_matches_pinocchio(robot, text, None, "flange")
+
+
+NEAR = ('<inertial><origin xyz="0.1 0.05 0.2" rpy="0.3 0.2 0.1"/><mass value="1.5"/>'
+        '<inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.025"/></inertial>')
+
+
+def _nearly_parallel_urdf(angle: float) -> str:
+    limit = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    return f"""<robot name="p"><link name="r"/><link name="a">{NEAR}</link>
+      <link name="b">{NEAR}</link><link name="c">{NEAR}</link>
+      <joint name="j1" type="revolute"><parent link="r"/><child link="a"/>
+        <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>{limit}</joint>
+      <joint name="j2" type="revolute"><parent link="a"/><child link="b"/>
+        <origin xyz="0.4 0.05 0.1" rpy="0 0 {angle!r}"/><axis xyz="0 1 0"/>{limit}</joint>
+      <joint name="j3" type="revolute"><parent link="b"/><child link="c"/>
+        <origin xyz="0.3 0 0" rpy="0.5 0 0"/><axis xyz="0 0 1"/>{limit}</joint></robot>"""
+
+
+@pytest.mark.parametrize(
+    ("angle", "tolerance"),
+    # treated as parallel: errors ~angle; above 5e-6 rad the exact common normal, ~1/angle away:
+    # errors ~eps / angle^2 (measured 1.6e-9, 7.8e-6, 7e-6, 9e-9, 3e-10 relative)
+    [(1e-9, 1e-8), (4.9e-6, 2e-5), (5.1e-6, 2e-5), (1e-4, 1e-7), (1e-3, 1e-9)],
+)
+def test_nearly_parallel_axes_are_reported(angle: float, tolerance: float) -> None:
+    text = _nearly_parallel_urdf(angle)
+    for convention in CONVENTIONS:
+        if angle < 1e-3:
+            with pytest.warns(UserWarning, match=r"joints 'j1' and 'j2': axes .* from parallel"):
+                robot = dynid.Robot.from_urdf(text, convention=convention)
+        else:
+            robot = dynid.Robot.from_urdf(text, convention=convention)
+        ref = reference(text, None, "c")
+        rigid = robot.rigid_body()
+        for q, qd, qdd in np.random.default_rng(0).uniform(-3, 3, (5, 3, 3)):
+            assert relative_error(rigid.rnea(q, qd, qdd), ref.rnea(q, qd, qdd)) < tolerance
+            assert relative_error(rigid.fkine(q), ref.tip_pose(q)) < tolerance
+
+
+@pytest.mark.parametrize("case", sorted(REAL))
+def test_real_arms_and_exactly_parallel_axes_give_no_warning(case: str) -> None:
+    import warnings
+
+    path, base_link, tip_link = REAL[case]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dynid.Robot.from_urdf(_text(path), base_link, tip_link)
+        dynid.Robot.from_urdf(_nearly_parallel_urdf(0.0))

@@ -9,7 +9,7 @@ x axis of the frame between two consecutive axes lies along their common normal.
 
 - Skew axes: the unique common normal, from the closest points of the two lines.
 - Intersecting axes: x = +-(u_i x u_{i+1}) through the intersection point.
-- Parallel axes (|u_i x u_{i+1}| < PARALLEL): the common normal through the previous frame's
+- Parallel axes (|u_i x u_{i+1}| < PARALLEL, 5e-6): the common normal through the previous frame's
   origin (standard) or through the point where the previous x axis meets axis i (modified), so
   that d_i = 0; coincident axes keep the previous x (theta = 0).
 - Frame 0 (both conventions): z along u_1, origin at the foot of the base origin on axis 1, x
@@ -33,10 +33,14 @@ from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
 
-#: Two axes whose directions differ by less than this angle [rad] count as parallel. Between
-#: this and the exact case, a DH table can only have its common normal far away (|d| ~ distance
-#: / angle); both choices cost at most ~1e-8 relative in the frames (sqrt of double precision).
-PARALLEL = 1e-8
+#: Two axes whose directions differ by less than this angle [rad] count as parallel. A DH table
+#: has no good form for nearly parallel axes: their common normal lies at ~distance / angle, and
+#: link parameters about such a far origin lose ~eps (distance / angle)^2 of precision, while
+#: treating the axes as parallel misplaces them by ~angle. Both are ~eps^(1/3) ~ 5e-6 relative
+#: at this threshold; see :func:`nearly_parallel`, which the reader warns about.
+PARALLEL = 5e-6
+#: Consecutive axes closer than this to parallel (but not within rounding of it) are reported.
+NEARLY_PARALLEL = (1e-10, 1e-3)
 
 
 def dh_standard(a: float, alpha: float, d: float, theta: float) -> Array:
@@ -68,6 +72,17 @@ def dh_frames(points: Array, axes: Array, tip: Array, convention: str) -> tuple[
     base = frame.copy()
     step = _standard_rows if convention == "standard" else _modified_rows
     return np.array(list(step(base, points, axes, tip))) + 0.0, base  # + 0.0: no -0.0 printed
+
+
+def nearly_parallel(axes: Array) -> list[tuple[int, float]]:
+    """(i, angle) for consecutive axes i, i+1 (0-based) within NEARLY_PARALLEL of parallel or
+    anti-parallel: the DH table then holds errors of up to ~5e-6 relative (see PARALLEL)."""
+    out = []
+    for i in range(len(axes) - 1):
+        angle = float(np.arcsin(min(1.0, np.linalg.norm(np.cross(axes[i], axes[i + 1])))))
+        if NEARLY_PARALLEL[0] < angle < NEARLY_PARALLEL[1]:
+            out.append((i, angle))
+    return out
 
 
 def _standard_rows(frame: Array, points: Array, axes: Array, tip: Array):

@@ -9,12 +9,13 @@ and what is fixed to it, links above ``base_link``) belong to the world and are 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .frames import dh_frames, dh_modified, dh_standard
+from .frames import PARALLEL, dh_frames, dh_modified, dh_standard, nearly_parallel
 from .tree import MOVABLE, Joint, UrdfTree, read_tree, serial_chain
 
 Array = NDArray[np.float64]
@@ -51,6 +52,16 @@ def dh_model_from_urdf(urdf, base_link: str | None = None, tip_link: str | None 
     points = np.array([poses[j.child][:3, 3] for j in joints])
     axes = np.array([poses[j.child][:3, :3] @ j.axis for j in joints])
     tip = poses[chain[-1].child]
+    for i, angle in nearly_parallel(axes):
+        # treated as parallel: axes misplaced by ~angle; else the common normal is ~1/angle away
+        # and parameters about it lose ~eps / angle^2 (measured against Pinocchio: docs/urdf.md)
+        snapped = angle < PARALLEL
+        error = angle if snapped else 2.2e-16 / angle**2
+        warnings.warn(
+            f"joints {joints[i].name!r} and {joints[i + 1].name!r}: axes {angle:.1e} rad from "
+            f"parallel, {'treated as parallel' if snapped else 'common normal far away'}; a DH "
+            f"table cannot represent them exactly: expect errors of ~{error:.0e} relative "
+            "(docs/urdf.md)", stacklevel=3)
     dh, base_pose = dh_frames(points, axes, tip, convention)
     frames = _dh_frames_at_zero(dh, base_pose, convention)
     bodies = _bodies(tree, chain, joints)
