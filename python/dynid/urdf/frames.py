@@ -9,9 +9,9 @@ x axis of the frame between two consecutive axes lies along their common normal.
 
 - Skew axes: the unique common normal, from the closest points of the two lines.
 - Intersecting axes: x = +-(u_i x u_{i+1}) through the intersection point.
-- Parallel axes (|u_i x u_{i+1}| < PARALLEL, 5e-6): the common normal through the previous frame's
-  origin (standard) or through the point where the previous x axis meets axis i (modified), so
-  that d_i = 0; coincident axes keep the previous x (theta = 0).
+- Parallel axes (|u_i x u_{i+1}| < PARALLEL = 5e-6): the common normal through the previous
+  frame's origin (standard) or through the point where the previous x axis meets axis i
+  (modified), so that d_i = 0; coincident axes keep the previous x (theta = 0).
 - Frame 0 (both conventions): z along u_1, origin at the foot of the base origin on axis 1, x
   along the base x axis projected on the plane normal to u_1 (its y axis if x is nearly along
   u_1): the base transform is the identity when axis 1 is the base z axis, as on most arms.
