@@ -47,11 +47,46 @@ def dh_model_from_urdf(urdf, base_link: str | None = None, tip_link: str | None 
         raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
     tree = read_tree(urdf)
     chain = serial_chain(tree, base_link, tip_link)
-    poses = _poses_at_zero(tree, chain[0].parent)  # every link below base_link, base_link coordinates
+    poses = _poses_at_zero(tree, chain[0].parent)  # links below base_link, in its coordinates
     joints = [joint for joint in chain if joint.type in MOVABLE]
+    # joint i's axis at q = 0: through the child's origin, along the axis in the child's axes
     points = np.array([poses[j.child][:3, 3] for j in joints])
     axes = np.array([poses[j.child][:3, :3] @ j.axis for j in joints])
+    _warn_nearly_parallel(joints, axes)
     tip = poses[chain[-1].child]
+    dh, base_pose = dh_frames(points, axes, tip, convention)
+    frames = _dh_frames_at_zero(dh, base_pose, convention)
+    return DHModel(
+        name=tree.name, dh=dh, joint_types="".join("P" if j.type == "prismatic" else "R"
+                                                  for j in joints),
+        convention=convention, base=base_pose, tool=np.linalg.inv(frames[-1]) @ tip,
+        params=_link_parameters(tree, joints, poses, frames[1:]),
+        qlim=np.array([_limits(j) for j in joints]),
+        Ia=np.array([j.rotor_inertia for j in joints]), Fv=np.array([j.damping for j in joints]),
+        Fs=np.array([j.friction for j in joints]), joint_names=[j.name for j in joints],
+        link_names=[j.child for j in joints],
+    )
+
+
+def _link_parameters(tree: UrdfTree, joints: list[Joint], poses: dict[str, Array],
+                     frames: list[Array]) -> Array:
+    """(n, 10): the inertials of body i (see the module docstring) in DH frame i, summed."""
+    bodies = _bodies(tree, joints)
+    params = np.zeros((len(joints), 10))
+    for i, joint in enumerate(joints):
+        inertials = [(link, tree.links[link]) for link, body in bodies.items()
+                     if body == i and tree.links[link] is not None]
+        if not inertials:
+            raise ValueError(f"link {joint.child!r} (moved by joint {joint.name!r}) has no "
+                             "<inertial>, nor has any link fixed to it")
+        to_frame = np.linalg.inv(frames[i])
+        for link, inertial in inertials:
+            params[i] += standard_parameters(inertial.mass, to_frame @ poses[link] @ inertial.origin,
+                                             inertial.inertia)
+    return params
+
+
+def _warn_nearly_parallel(joints: list[Joint], axes: Array) -> None:
     for i, angle in nearly_parallel(axes):
         # treated as parallel: axes misplaced by ~angle; else the common normal is ~1/angle away
         # and parameters about it lose ~eps / angle^2 (measured against Pinocchio: docs/urdf.md)
@@ -61,30 +96,7 @@ def dh_model_from_urdf(urdf, base_link: str | None = None, tip_link: str | None 
             f"joints {joints[i].name!r} and {joints[i + 1].name!r}: axes {angle:.1e} rad from "
             f"parallel, {'treated as parallel' if snapped else 'common normal far away'}; a DH "
             f"table cannot represent them exactly: expect errors of ~{error:.0e} relative "
-            "(docs/urdf.md)", stacklevel=3)
-    dh, base_pose = dh_frames(points, axes, tip, convention)
-    frames = _dh_frames_at_zero(dh, base_pose, convention)
-    bodies = _bodies(tree, chain, joints)
-    params = np.zeros((len(joints), 10))
-    for i, joint in enumerate(joints):
-        links = [link for link, body in bodies.items() if body == i]
-        inertials = [(link, tree.links[link]) for link in links if tree.links[link] is not None]
-        if not inertials:
-            raise ValueError(f"link {joint.child!r} (moved by joint {joint.name!r}) has no "
-                             "<inertial>, nor has any link fixed to it")
-        to_frame = np.linalg.inv(frames[i + 1])
-        for link, inertial in inertials:
-            params[i] += standard_parameters(inertial.mass, to_frame @ poses[link] @ inertial.origin,
-                                             inertial.inertia)
-    return DHModel(
-        name=tree.name, dh=dh, joint_types="".join("P" if j.type == "prismatic" else "R"
-                                                  for j in joints),
-        convention=convention, base=base_pose, tool=np.linalg.inv(frames[-1]) @ tip,
-        params=params, qlim=np.array([_limits(j) for j in joints]),
-        Ia=np.array([j.rotor_inertia for j in joints]), Fv=np.array([j.damping for j in joints]),
-        Fs=np.array([j.friction for j in joints]), joint_names=[j.name for j in joints],
-        link_names=[j.child for j in joints],
-    )
+            "(docs/urdf.md)", stacklevel=4)  # the caller of Robot.from_urdf
 
 
 def standard_parameters(mass: float, pose: Array, inertia: Array) -> Array:
@@ -118,7 +130,7 @@ def _poses_at_zero(tree: UrdfTree, base: str) -> dict[str, Array]:
     return poses
 
 
-def _bodies(tree: UrdfTree, chain: list[Joint], joints: list[Joint]) -> dict[str, int]:
+def _bodies(tree: UrdfTree, joints: list[Joint]) -> dict[str, int]:
     """Link -> index of the chain joint that moves it (0-based); links of the world left out."""
     index = {joint.child: i for i, joint in enumerate(joints)}
     bodies: dict[str, int] = {}
