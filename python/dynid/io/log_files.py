@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import signal as sig
-from .._checks import real_array
+from .._checks import count, is_integer, real_array
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -145,6 +145,9 @@ class Log:
                 raise ValueError(f"mask: expected a boolean array of shape ({self.T},), got {mask.shape}")
             kept = int(mask.sum())
         elif np.issubdtype(mask.dtype, np.integer) and mask.ndim == 1:
+            if mask.size and (mask.min() < 0 or mask.max() >= self.T):
+                raise ValueError(f"mask: sample indices must lie in [0, {self.T}), got "
+                                 f"{mask.min()}..{mask.max()}")
             kept = mask.size
         else:
             raise ValueError(
@@ -160,8 +163,7 @@ class Log:
               note: str | None = None) -> Log:
         """Samples start:stop (Python slice semantics, negative indices allowed)."""
         for name, value in (("start", start), ("stop", stop)):
-            if value is not None and (isinstance(value, bool)
-                                      or not isinstance(value, (int, np.integer))):
+            if value is not None and not is_integer(value):
                 raise ValueError(f"{name}: expected an integer or None, got {value!r}")
         lo, hi, _ = slice(start, stop).indices(self.T)
         if note is None:
@@ -211,8 +213,7 @@ def load_log(path: PathLike, *, skip: int = 0) -> Log:
     suffix = path.suffix.lower()
     if suffix not in (".npz", ".csv"):
         raise ValueError(f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv")
-    if isinstance(skip, bool) or not isinstance(skip, (int, np.integer)) or skip < 0:
-        raise ValueError(f"skip: expected a non-negative integer, got {skip!r}")
+    skip = count(skip, "skip", 0)
     try:
         log = _load_npz(path) if suffix == ".npz" else _load_csv(path)
     except ValueError as exc:

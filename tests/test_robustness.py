@@ -1,0 +1,146 @@
+"""Regression tests for the audit of issue 14 (Python side): structural base parameters, silent
+NaN, arguments of the wrong type, result folders that are never mixed or half-written."""
+
+from __future__ import annotations
+
+import json
+
+import dynid
+import numpy as np
+import pytest
+from dynid import excitation, io, signal
+from dynid.io.output_folder import output_folder, write_text_atomic
+from dynid.io.result_files import load_result, save_result
+from dynid.log_identification import identify_log
+
+# --------------------------------------------------------------------------- item 6
+
+
+@pytest.mark.parametrize("width", [1e-6, 1e-3, 0.05])
+def test_base_parameters_ignore_joint_limits(width: float) -> None:
+    """SPEC 3: the counts are structural (43/12/39 on the LWR-IV) whatever the limits, and the
+    cached beta reproduces Y pi at configurations far outside those limits (1e-10 relative)."""
+    robot = dynid.models.kuka_lwr4()
+    robot.qlim = np.column_stack([np.full(7, 0.3), np.full(7, 0.3 + width)])
+    counts = [dynid.base_parameters(robot, kind).count for kind in ("torque", "gravity", "inertia")]
+    assert counts == [43, 12, 39]
+    base = dynid.base_parameters(robot, "torque")
+    rng = np.random.default_rng(3)
+    q, qd, qdd = rng.uniform(-3, 3, (3, 50, 7))
+    Y = robot.regressor(q, qd, qdd)
+    pi = robot.parameter_vector()
+    full = Y @ pi
+    reduced = base.reduce(Y) @ base.values(robot)
+    assert np.max(np.abs(full - reduced)) <= 1e-10 * np.max(np.abs(full))
+
+
+def test_base_parameter_cache_follows_gravity() -> None:
+    """The cache is keyed on what the structure depends on: gravity along a joint axis removes
+    gravity base parameters, and the cached result for the old gravity is not reused."""
+    robot = dynid.models.planar_2r()
+    vertical = dynid.base_parameters(robot, "torque").count
+    robot.gravity_vector = (0.0, 0.0, 0.0)
+    assert dynid.base_parameters(robot, "torque").count < vertical
+
+
+# --------------------------------------------------------------------------- item 5
+
+
+def test_fourier_trajectory_overflow_is_an_error() -> None:
+    huge = excitation.FourierTrajectory(1.0, np.full((2, 3), 1e308), np.full((2, 3), 1e308),
+                                        np.zeros(2))
+    with pytest.raises(ValueError, match="^t: .*overflow"):
+        huge.evaluate(np.linspace(0.0, 1.0, 5))
+    ordinary = excitation.FourierTrajectory(1.0, np.ones((2, 3)), np.ones((2, 3)), np.zeros(2))
+    with pytest.raises(ValueError, match="^t: .*overflow"):
+        ordinary.evaluate([1e308])
+    q, qd, qdd = ordinary.evaluate([0.0, 0.5])  # ordinary values still work
+    assert np.all(np.isfinite(q)) and q.shape == (2, 2)
+
+
+def test_differentiate_overflow_is_an_error() -> None:
+    with pytest.raises(ValueError, match="^x: the derivative overflows"):
+        signal.differentiate(np.array([0.0, 1e308, -1e308, 0.0]), fs=1e3)
+    x = np.sin(np.linspace(0, 1, 101))
+    assert np.all(np.isfinite(signal.differentiate(x, fs=100.0)))
+
+
+# --------------------------------------------------------------------------- item 9
+
+
+def _robot() -> dynid.Robot:
+    return dynid.models.kuka_lwr4()
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda: dynid.least_squares(np.eye(3), np.ones(3), names=5), "names"),
+        (lambda: dynid.least_squares(np.eye(3), np.ones(3), names=["a", "b"]), "names"),
+        (lambda: dynid.identify_from_controller(_robot(), np.zeros((3, 7)), np.zeros((3, 7)),
+                                                np.zeros((3, 7, 7)), exclude_gravity_joints=None),
+         "exclude_gravity_joints"),
+        (lambda: dynid.identify_from_controller("robot", np.zeros((3, 7)), np.zeros((3, 7)),
+                                                np.zeros((3, 7, 7))), "structure"),
+        (lambda: dynid.base_parameters("robot"), "robot"),
+        (lambda: dynid.base_parameters(_robot(), "torque", rotor="no"), "rotor"),
+        (lambda: setattr(_robot(), "qlim", [[10**400, 1]] * 7), "qlim"),
+        (lambda: io.Log(np.arange(5.0), np.zeros((5, 2)), np.zeros((5, 2))).select([7]), "mask"),
+        (lambda: _robot().with_payload(1.0, [0, 0, 9e307]), "com"),
+        (lambda: _robot().random_configurations(1.7), "count"),
+        (lambda: _robot().set_link(True, 1.0, np.zeros(3), np.eye(3)), "i"),
+    ],
+)
+def test_wrong_arguments_are_value_errors_naming_them(call, name: str) -> None:
+    with pytest.raises(ValueError, match=f"^{name}: "):
+        call()
+
+
+# --------------------------------------------------------------------------- item 11
+
+
+@pytest.fixture(scope="module")
+def small_result():
+    rng = np.random.default_rng(0)
+    robot = dynid.models.planar_2r()
+    t = np.arange(400) / 100.0
+    q = np.column_stack([np.sin(t), np.cos(1.3 * t)])
+    qd = np.column_stack([np.cos(t), -1.3 * np.sin(1.3 * t)])
+    qdd = np.column_stack([-np.sin(t), -1.69 * np.cos(1.3 * t)])
+    tau = robot.rnea(q, qd, qdd) + 1e-3 * rng.normal(size=q.shape)
+    return identify_log(io.Log(t, q, tau, qd, qdd), robot)
+
+
+def test_result_folder_is_not_overwritten_silently(small_result, tmp_path) -> None:
+    out = tmp_path / "run"
+    save_result(small_result, out, plots=False)
+    before = (out / "result.json").read_text()
+    (out / "keep.txt").write_text("user file")
+    with pytest.raises(ValueError, match="^output: .*not empty.*overwrite"):
+        save_result(small_result, out, plots=False)
+    assert (out / "result.json").read_text() == before
+    save_result(small_result, out, plots=False, overwrite=True)
+    # replaced as a whole: no file of the previous run is left beside the new one
+    assert sorted(p.name for p in out.iterdir()) == ["result.json"]
+    assert load_result(out).theta.shape == small_result.theta.shape
+    with pytest.raises(ValueError, match="^output: expected a folder path"):
+        save_result(small_result, "", plots=False)
+
+
+def test_a_failing_write_leaves_the_old_folder_untouched(tmp_path) -> None:
+    out = tmp_path / "run"
+    with output_folder(out) as staging:
+        (staging / "a.json").write_text("{}")
+    with pytest.raises(RuntimeError, match="plot failed"), output_folder(out, True) as staging:
+        (staging / "a.json").write_text('{"half": ')
+        raise RuntimeError("plot failed")
+    assert json.loads((out / "a.json").read_text()) == {}
+    assert [p.name for p in tmp_path.iterdir()] == ["run"]  # no staging folder left behind
+
+
+def test_write_text_atomic(tmp_path) -> None:
+    target = tmp_path / "x.txt"
+    write_text_atomic(target, "one")
+    write_text_atomic(target, "two")
+    assert target.read_text() == "two"
+    assert [p.name for p in tmp_path.iterdir()] == ["x.txt"]
