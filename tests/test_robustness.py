@@ -144,3 +144,56 @@ def test_write_text_atomic(tmp_path) -> None:
     write_text_atomic(target, "two")
     assert target.read_text() == "two"
     assert [p.name for p in tmp_path.iterdir()] == ["x.txt"]
+
+
+# --------------------------------------------------------------------------- item 13
+
+
+def _chunk_gravity(args: tuple[dynid.Robot, np.ndarray]) -> np.ndarray:
+    robot, q = args
+    return robot.gravity(q)
+
+
+def test_robot_pickles_copies_and_compares() -> None:
+    import copy
+    import pickle
+
+    robot = dynid.models.kuka_lwr4()
+    robot.Ia, robot.Fv = np.arange(7.0), np.full(7, 0.5)
+    robot.qlim = np.tile([-2.0, 2.0], (7, 1))
+    for other in (pickle.loads(pickle.dumps(robot)), copy.copy(robot), copy.deepcopy(robot)):
+        assert other == robot and other is not robot and type(other) is type(robot)
+        q = np.linspace(-1, 1, 7)
+        assert np.array_equal(other.rnea(q, q, q), robot.rnea(q, q, q))
+    changed = robot.copy()
+    changed.Fs = np.ones(7)
+    assert changed != robot
+    assert robot != "robot"
+    assert np.array_equal(pickle.loads(pickle.dumps(robot.gravity))(np.zeros(7)),
+                          robot.gravity(np.zeros(7)))
+
+
+def test_results_pickle_and_compare(small_result) -> None:
+    import pickle
+
+    base = dynid.base_parameters(dynid.models.kuka_lwr4())
+    fit = dynid.least_squares(np.vstack([np.eye(4), np.ones((2, 4))]), np.arange(6.0))
+    for value in (base, fit, small_result):
+        again = pickle.loads(pickle.dumps(value))
+        assert again == value
+        assert (again != value) is False
+    assert fit != dynid.least_squares(np.vstack([np.eye(4), np.ones((2, 4))]), np.arange(6.0) + 1)
+
+
+@pytest.mark.parametrize("method", ["fork", "spawn"])
+def test_gravity_over_a_process_pool(method: str) -> None:
+    """Chunks of a trajectory sent with the robot to worker processes give the same torques as
+    one batch call here (exact: the same C++ code on the same numbers)."""
+    import multiprocessing
+
+    robot = dynid.models.kuka_lwr4()
+    q = robot.random_configurations(400, seed=1)
+    chunks = [(robot, part) for part in np.array_split(q, 4)]
+    with multiprocessing.get_context(method).Pool(2) as pool:
+        parts = pool.map(_chunk_gravity, chunks)
+    assert np.array_equal(np.concatenate(parts), robot.gravity(q))

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _checks as checks
+from ._equality import ValueEquality
 from .robot import Robot
 
 #: A column is independent when, after scaling every column to unit norm, the part of it outside
@@ -42,8 +43,8 @@ NOISE_RATIO = 1e-10
 KINDS = ("torque", "gravity", "inertia")
 
 
-@dataclass(frozen=True)
-class BaseParameters:
+@dataclass(frozen=True, eq=False)
+class BaseParameters(ValueEquality):
     """The base (grouped) parameters of a robot for one kind of regressor."""
 
     kind: str

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
+from ._equality import ValueEquality
 from ._checks import real_array
 from .base_parameters import (
     BaseParameters,
@@ -44,8 +45,8 @@ class ZeroElement:
     constraints: list[str]  #: readable linear constraints on the standard parameters, "... = 0"
 
 
-@dataclass
-class IdentifiedModel:
+@dataclass(eq=False)
+class IdentifiedModel(ValueEquality):
     """The model rebuilt from identified coefficients; usable like a Robot for prediction.
 
     ``gravity``, ``mass_matrix``, ``coriolis``, ``coriolis_matrix`` and ``rnea`` (the joint

@@ -23,6 +23,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
+from ._equality import ValueEquality
 from ._checks import real_array
 
 METHODS = ("ols", "wls")
@@ -48,8 +49,8 @@ class RankDeficientError(ValueError):
     """The data do not excite all base parameters: the stacked regressor has rank < p."""
 
 
-@dataclass(frozen=True)
-class LeastSquaresResult:
+@dataclass(frozen=True, eq=False)
+class LeastSquaresResult(ValueEquality):
     """An estimate theta of the p parameters with its uncertainty (see :func:`least_squares`)."""
 
     theta: NDArray[np.float64]  #: (p,) estimate

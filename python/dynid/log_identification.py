@@ -28,6 +28,7 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
+from ._equality import ValueEquality
 from .base_parameters import base_parameters
 from .identify import least_squares
 from .io.log_files import Log
@@ -47,7 +48,7 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 
 @dataclass(eq=False)
-class LogIdentification:
+class LogIdentification(ValueEquality):
     """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
@@ -74,8 +75,9 @@ class LogIdentification:
     rank: int
     excluded: tuple[int, ...] = ()
     training: dict[str, Any] = field(default_factory=dict)
-    log: Log | None = field(default=None, repr=False)  #: the prepared training log (not saved)
-    _robot: Robot | None = field(default=None, repr=False)
+    #: the prepared training log (not saved, not compared)
+    log: Log | None = field(default=None, repr=False, compare=False)
+    _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
     def n(self) -> int:
@@ -209,7 +211,7 @@ def identify_log(
 
 
 @dataclass(eq=False)
-class LogValidation:
+class LogValidation(ValueEquality):
     """An identified model applied to another log: the prepared log, the predicted torques and
     the per-joint errors (:func:`dynid.validation.error_metrics`)."""
 

@@ -165,6 +165,30 @@ class Robot(_core.Model):
             names += [f"Fv{i}" for i in links] + [f"Fs{i}" for i in links]
         return names
 
+    # ---- copies, pickling, equality (multiprocessing, Dask and Ray pickle what they send) -----
+    def _state(self) -> dict[str, object]:
+        """Everything that defines the robot (derived caches such as base parameters excluded)."""
+        return {
+            "dh": self.dh, "joint_types": self.joint_types, "convention": self.convention,
+            "gravity": self.gravity_vector, "params": self.params, "base": self.base,
+            "tool": self.tool, "qlim": self.qlim, "name": self.name,
+            "Ia": self.Ia, "Fv": self.Fv, "Fs": self.Fs,
+        }
+
+    def __reduce__(self) -> tuple[object, tuple[dict[str, object]]]:
+        return (_robot_from_state, (self._state(),))
+
+    def __eq__(self, other: object) -> bool:
+        """Same DH table, joint types, convention, gravity, transforms, parameters, drive terms,
+        limits and name (exact comparison)."""
+        if not isinstance(other, Robot):
+            return NotImplemented
+        mine, theirs = self._state(), other._state()
+        return all(np.array_equal(mine[k], theirs[k]) if isinstance(mine[k], np.ndarray)
+                   else mine[k] == theirs[k] for k in mine)
+
+    __hash__ = None  # type: ignore[assignment]  # parameters are settable
+
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""
         other = Robot.from_dh(
@@ -225,6 +249,15 @@ class Robot(_core.Model):
         rng = np.random.default_rng(seed)
         low, high = self.qlim[:, 0], self.qlim[:, 1]
         return low + (high - low) * rng.random((count, self.n))
+
+
+def _robot_from_state(state: dict[str, object]) -> Robot:
+    """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
+    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],  # type: ignore[arg-type]
+                          state["gravity"], state["params"], state["base"], state["tool"],  # type: ignore[arg-type]
+                          state["qlim"], state["name"])  # type: ignore[arg-type]
+    robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
+    return robot
 
 
 def _default_limits(joint_types: Sequence[str]) -> NDArray[np.float64]:

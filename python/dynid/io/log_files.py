@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import signal as sig
 from .._checks import count, is_integer, real_array
+from .._equality import ValueEquality
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -40,7 +41,7 @@ PathLike = Union[str, Path]
 
 
 @dataclass(eq=False, repr=False)
-class Log:
+class Log(ValueEquality):
     """A measurement log: t (T,), q and tau (T, n), optional qd and qdd (T, n).
 
     ``t`` is kept as recorded (it may start anywhere, e.g. at a Unix time). ``notes`` lists, in
