@@ -8,6 +8,7 @@ import json
 import dynid
 import numpy as np
 import pytest
+import dynid.cli
 from dynid import excitation, io, signal
 from dynid.io.output_folder import output_folder, write_text_atomic
 from dynid.io.result_files import load_result, save_result
@@ -197,3 +198,73 @@ def test_gravity_over_a_process_pool(method: str) -> None:
     with multiprocessing.get_context(method).Pool(2) as pool:
         parts = pool.map(_chunk_gravity, chunks)
     assert np.array_equal(np.concatenate(parts), robot.gravity(q))
+
+
+# --------------------------------------------------------------------------- items 8 and 10
+
+
+def _write_bad_inputs(folder) -> dict[str, str]:
+    files = {}
+    (folder / "rows300.json").write_text(json.dumps(
+        {"convention": "standard", "rows": [[0, 0, 0.1, 0]] * 300}))
+    files["rows300.json"] = "rows: 300 DH rows"
+    (folder / "hugeint.json").write_text(
+        '{"convention": "standard", "rows": [[1' + "0" * 400 + ", 0, 0, 0]]}")
+    files["hugeint.json"] = "rows[0]: expected numbers"
+    (folder / "deep.json").write_text(
+        '{"convention": "standard", "rows": ' + "[" * 100000 + "]" * 100000 + "}")
+    files["deep.json"] = "nesting too deep"
+    (folder / "wrongtype.json").write_text('{"convention": 5, "rows": [[0, 0, 0, 0]]}')
+    files["wrongtype.json"] = "convention: expected"
+    levels = ["a: &a [" + ",".join(["1"] * 9) + "]"]
+    for i in range(1, 9):
+        previous = "a" if i == 1 else f"l{i - 1}"
+        levels.append(f"l{i}: &l{i} [" + ",".join([f"*{previous}"] * 9) + "]")
+    (folder / "bomb.yaml").write_text("\n".join(levels) + "\n")
+    files["bomb.yaml"] = "expands to more than"
+    return files
+
+
+@pytest.mark.parametrize("name", ["rows300.json", "hugeint.json", "deep.json", "wrongtype.json",
+                                  "bomb.yaml"])
+def test_cli_model_file_errors_are_one_line(name, tmp_path, capsys) -> None:
+    """Exit 2 and one line naming the file and the field; no traceback, no minutes of work."""
+    expected = _write_bad_inputs(tmp_path)[name]
+    status = dynid.cli.main(["info", "--model", str(tmp_path / name)])
+    err = capsys.readouterr().err.strip()
+    assert status == 2
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert name in err and expected in err
+
+
+def _npz_with_header(folder, shape: str) -> str:
+    import io as pyio
+    import zipfile
+
+    buffer = pyio.BytesIO()
+    np.save(buffer, np.zeros(3))
+    member = buffer.getvalue().replace(b"(3,)", shape.encode())
+    path = folder / "header.npz"
+    with zipfile.ZipFile(path, "w") as archive:
+        for key in ("t", "q", "tau"):
+            archive.writestr(f"{key}.npy", member)
+    return str(path)
+
+
+def test_cli_log_errors_are_one_line(tmp_path, capsys) -> None:
+    import zipfile
+
+    cases = {_npz_with_header(tmp_path, "(99999999999,)"): "its header asks for shape"}
+    other = tmp_path / "member.npz"
+    with zipfile.ZipFile(other, "w") as archive:
+        archive.writestr("t.txt", "hello")
+    cases[str(other)] = "member 't.txt' is not a .npy array"
+    result = tmp_path / "result.json"
+    result.write_text('{"format": "dynid-identification", "version": 1, "model": []}')
+    for path, expected in cases.items():
+        status = dynid.cli.main(["identify", path, "--output", str(tmp_path / "out")])
+        err = capsys.readouterr().err.strip()
+        assert status == 2 and len(err.splitlines()) == 1 and expected in err
+    status = dynid.cli.main(["validate", str(result), str(other), "--output", str(tmp_path / "v")])
+    err = capsys.readouterr().err.strip()
+    assert status == 2 and len(err.splitlines()) == 1 and "model" in err

@@ -233,6 +233,7 @@ def _load_npz(path: Path) -> Log:
         raise ValueError(f"not a readable NPZ file ({type(exc).__name__}: {exc})") from None
     with data:
         found = list(data.files)
+        _check_npz_members(path)
         arrays: dict[str, Any] = {}
         flobaroid = False
         for name, aliases in NPZ_KEYS.items():
@@ -258,6 +259,30 @@ def _load_npz(path: Path) -> Log:
     how = "FloBaRoID key names" if flobaroid else "dynid key names"
     note = f"loaded from {path.name} (NPZ, {how}; {', '.join(arrays)})"
     return Log(**arrays, source=str(path), notes=notes + [note])
+
+
+def _check_npz_members(path: Path) -> None:
+    """Refuse a member whose .npy header asks for more bytes than the member holds (a corrupt or
+    hostile header would otherwise make NumPy try to allocate it) or that is not .npy at all."""
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            if not info.filename.endswith(".npy"):
+                raise ValueError(f"member {info.filename!r} is not a .npy array")
+            with archive.open(info) as member:
+                try:
+                    version = np.lib.format.read_magic(member)
+                    read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                            else np.lib.format.read_array_header_2_0)
+                    shape, _, dtype = read(member)
+                except (ValueError, OSError, EOFError) as exc:
+                    raise ValueError(f"member {info.filename!r}: unreadable header ({exc})"
+                                     ) from None
+            needed = dtype.itemsize * int(np.prod(shape, dtype=object))
+            if needed > info.file_size:
+                raise ValueError(
+                    f"member {info.filename!r}: its header asks for shape {shape} "
+                    f"({needed} bytes) but the member holds {info.file_size} bytes"
+                )
 
 
 _CSV_COLUMN = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
