@@ -331,3 +331,20 @@ def test_result_file_carries_covariance_units_and_version(small_result, tmp_path
     path.write_text(json.dumps(data))
     with pytest.raises(ValueError, match="version: expected a format version 1..2"):
         load_result(path)
+
+
+# --------------------------------------------------------------------------- item 15
+
+
+def test_import_dynid_loads_no_plotting_or_optimisers() -> None:
+    """``import dynid`` stays light (its time is measured in bench/, never here): matplotlib,
+    SciPy's optimisers and signal processing load only when a function needs them."""
+    import subprocess
+    import sys
+
+    heavy = ("matplotlib", "scipy.optimize", "scipy.signal", "scipy.ndimage")
+    code = ("import sys, dynid; dynid.Robot; dynid.models.kuka_lwr4(); "
+            f"print(','.join(m for m in {heavy!r} if m in sys.modules))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            check=True).stdout.strip()
+    assert loaded == ""
