@@ -16,7 +16,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
 from . import _core
-from .urdf import dh_model_from_urdf, urdf_text, write_urdf
 
 PARAMETER_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
 
@@ -124,6 +123,8 @@ class Robot(_core.Model):
         without ``tip_link``, floating, planar or mimic joints on the chain, a moving link
         without any inertial, an axis of zero length.
         """
+        from .urdf import dh_model_from_urdf  # on first use: import dynid stays fast
+
         model = dh_model_from_urdf(urdf, base_link, tip_link, convention)
         robot = cls.from_dh(model.dh, model.joint_types, convention, gravity, model.params,
                             model.base, model.tool, model.qlim, model.name)
@@ -142,6 +143,8 @@ class Robot(_core.Model):
         :meth:`from_urdf` reads back. ValueError naming the first link that is not physically
         consistent.
         """
+        from .urdf import urdf_text, write_urdf  # on first use: import dynid stays fast
+
         text = urdf_text(self, name)
         if path is not None:
             write_urdf(text, path, overwrite)
