@@ -109,3 +109,9 @@ def test_ur_models(factory, file: str, lengths: tuple, convention: str) -> None:
         np.testing.assert_allclose(np.abs(robot.dh[:, 0]), [0, a2, a3, 0, 0, 0], atol=1e-12)
         np.testing.assert_allclose(np.abs(robot.dh[:, 2]), [d1, 0, 0, d4, d5, d6], atol=1e-12)
     np.testing.assert_allclose(robot.base, np.eye(4), atol=1e-15)
+
+
+def test_the_installed_package_ships_its_data() -> None:
+    # wheel.packages = ["python/dynid"] ships every file of the folder, not only .py ones
+    for name in ("franka_panda_gaz2019.csv", "ur5.urdf", "ur10.urdf", "README.md"):
+        assert files("dynid").joinpath("data", name).is_file(), name
