@@ -86,7 +86,8 @@ def nearly_parallel(axes: Array) -> list[tuple[int, float]]:
 
 
 def _standard_rows(frame: Array, points: Array, axes: Array, tip: Array):
-    # Frame i-1 has z on axis i; frame i has z on axis i+1, x on the common normal (Spong 3.2).
+    # Frame i-1 has z on axis i; frame i has z on axis i+1, x on the common normal
+    # (Spong, Hutchinson, Vidyasagar, "Robot Modeling and Control", ch. 3).
     n = len(axes)
     for i in range(n):
         origin, x_prev, z_prev = frame[:3, 3], frame[:3, 0], frame[:3, 2]
@@ -106,7 +107,8 @@ def _standard_rows(frame: Array, points: Array, axes: Array, tip: Array):
 
 
 def _modified_rows(frame: Array, points: Array, axes: Array, tip: Array):
-    # Frame i has z on axis i, origin on it at the common normal to axis i+1 (Craig 3.4).
+    # Frame i has z on axis i, origin on it at the common normal to axis
+    # i+1 (Craig, "Introduction to Robotics", ch. 3).
     n = len(axes)
     a, alpha = 0.0, 0.0  # frame 0 has z on axis 1 already
     for i in range(n):
