@@ -94,6 +94,11 @@ def _add_model(p: argparse.ArgumentParser) -> None:
 def _add_preparation(p: argparse.ArgumentParser) -> None:
     p.add_argument("--skip", type=int, default=0, metavar="N",
                    help="drop the first N samples (start-up transient)")
+    p.add_argument("--columns", metavar="MAP",
+                   help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
+                   "(glob patterns, joints in natural order; docs/data.md)")
+    p.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s",
+                   help="unit of the log's time stamps (default s)")
     p.add_argument("--cutoff", type=float, metavar="HZ",
                    help="zero-phase Butterworth low-pass of q, qd, qdd, tau at HZ")
     p.add_argument("--order", type=int, default=4, help="order of that filter (default 4)")
