@@ -262,7 +262,8 @@ def test_bad_noise_levels_raise_value_error_naming_them(name, value):
     ("kwargs", "name"),
     [({"link_friction": -0.1}, "link_friction"), ({"link_friction": 1.5}, "link_friction"),
      ({"link_friction": np.ones(6)}, "link_friction"), ({"link_friction": "a"}, "link_friction"),
-     ({"encoder_counts": 0}, "encoder_counts"), ({"encoder_counts": np.nan}, "encoder_counts")],
+     ({"encoder_counts": 0}, "encoder_counts"), ({"encoder_counts": np.nan}, "encoder_counts"),
+     ({"encoder_counts": "many"}, "encoder_counts"), ({"encoder_counts": True}, "encoder_counts")],
 )
 def test_bad_sensor_settings_raise_value_error_naming_them(kwargs, name):
     with pytest.raises(ValueError, match=rf"^{name}\b"):

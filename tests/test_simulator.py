@@ -344,6 +344,7 @@ def test_too_large_a_step_is_reported_not_returned_as_nan(lwr):
         ({"qd0": np.zeros((7, 1))}, "qd0"),
         ({"duration": 0.0}, "duration"),
         ({"duration": 1.0005}, "duration"),
+        ({"duration": 1e7, "dt": 1e-3}, "duration"),
         ({"dt": -1e-3}, "dt"),
         ({"dt": np.inf}, "dt"),
         ({"substeps": 0}, "substeps"),

@@ -103,6 +103,9 @@ def simulate(
     dt = _number(dt, "dt", positive=True)
     duration = _number(duration, "duration", positive=True)
     periods = round(duration / dt)
+    if periods > 2**31 - 2:
+        raise ValueError(f"duration: at most 2^31 - 2 control periods, got {periods} "
+                         f"({duration:g} s at dt = {dt:g} s)")
     if periods < 1 or abs(periods * dt - duration) > 1e-9 * max(duration, dt):
         raise ValueError(
             f"duration: expected a positive whole number of control periods dt = {dt:g} s, "

@@ -123,7 +123,7 @@ class VirtualController:
                 f"link_friction: expected a fraction in [0, 1], scalar or shape ({robot.n},), "
                 f"got {link_friction!r}"
             )
-        if encoder_counts is not None and not (np.isfinite(encoder_counts) and encoder_counts > 0):
+        if encoder_counts is not None and not _positive_number(encoder_counts):
             raise ValueError(
                 f"encoder_counts: expected a positive count or None, got {encoder_counts!r}"
             )
@@ -212,6 +212,16 @@ class VirtualController:
         if self.position_noise == 0.0:
             return q.copy()
         return q + self.position_noise * self.rng.standard_normal(q.shape)
+
+
+def _positive_number(value: object) -> bool:
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return False
+    return bool(np.isfinite(number) and number > 0.0)
 
 
 def stable_substeps(robot: Robot, q: ArrayLike, dt: float, coulomb_band: float,
