@@ -14,9 +14,8 @@ reversal at t = 7 s the distal joints lose 11-17 mrad (0.1 mrad for a robot with
 
 from __future__ import annotations
 
-import numpy as np
-
 import dynid
+import numpy as np
 from dynid.sim import ComputedTorque, PDGravity, paper_validation_trajectory, simulate
 
 
