@@ -7,7 +7,8 @@ one way from the model to the files:
 - the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`, :mod:`dynid.urdf`
   (``Robot.from_urdf`` / ``Robot.to_urdf``);
 - its linear parametrisation: :mod:`~dynid.base_parameters`;
-- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (a virtual robot);
+- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (closed-loop
+  simulation, a virtual robot);
 - identification: :mod:`~dynid.identify` (least squares), :mod:`~dynid.from_controller` (the
   paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
   :mod:`~dynid.recursive`;

@@ -1,7 +1,8 @@
 // Built-in joint-space control laws for the Simulator (notes, "Use of the dynamic model"). Each
 // controller reads the desired trajectory sampled at the control instants and, where it uses a
 // model, evaluates its own Model (possibly not the plant's, to show the effect of a mismatch) in
-// its own Workspace: a command allocates nothing.
+// its own Workspace: a command allocates nothing. A controller keeps references to its Model and
+// to the reference arrays: both must outlive it.
 #pragma once
 
 #include "dynid/model.hpp"

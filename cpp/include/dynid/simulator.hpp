@@ -56,7 +56,8 @@ struct SimulationOutput {
 
 class Simulator {
  public:
-  // Throws std::invalid_argument naming the setting when one is out of range.
+  // Keeps a reference to `plant`, which must outlive the Simulator. Throws std::invalid_argument
+  // naming the setting when one is out of range.
   Simulator(const Model& plant, const SimulationSettings& settings);
 
   // Runs `periods` control periods from (q0, qd0). Throws std::invalid_argument naming the

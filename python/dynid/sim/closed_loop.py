@@ -123,7 +123,7 @@ def simulate(
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
 
-    t = np.arange(periods + 1) * dt
+    t = (np.arange(periods + 1) * dt).astype(np.float64)
     law = _controller_arguments(controller, robot, t, n)
     q, qd, qdd, tau, q_measured = _core._simulate(
         robot, q0, qd0, periods, dt, substeps, method, bool(friction), coulomb_band,
