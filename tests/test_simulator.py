@@ -315,6 +315,29 @@ def test_exact_sign_friction_and_prismatic_joints_run(lwr):
     assert np.all(np.isfinite(signed.q))
 
 
+def test_builtin_controllers_run_without_the_gil(lwr):
+    # While a 10 s run at h = 1e-4 (100000 periods, ~0.5-2 s of C++) goes on in a thread, the
+    # main thread keeps running Python: the longest pause between its loop iterations stays below
+    # half the run's duration (it would span the whole C++ run if the GIL were held).
+    import threading
+    import time
+
+    done = []
+    worker = threading.Thread(target=lambda: done.append(
+        simulate(lwr, Q0, QD0, 10.0, PDGravity(lwr, KP, KD, np.zeros(7)), dt=1e-4)))
+    start = last = time.perf_counter()
+    longest = 0.0
+    worker.start()
+    while worker.is_alive():
+        now = time.perf_counter()
+        longest = max(longest, now - last)
+        last = now
+    worker.join()
+    duration = time.perf_counter() - start
+    assert done and done[0].q.shape == (100001, 7)
+    assert longest < 0.5 * duration, (longest, duration)
+
+
 # --- errors --------------------------------------------------------------------------------------
 
 
