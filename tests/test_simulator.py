@@ -338,6 +338,23 @@ def test_builtin_controllers_run_without_the_gil(lwr):
     assert longest < 0.5 * duration, (longest, duration)
 
 
+def test_a_long_run_stops_on_keyboard_interrupt(lwr):
+    # Ctrl-C (here _thread.interrupt_main from a timer, 0.2 s in) ends a 100 s run (10^5 periods
+    # of 50 RK4 substeps, 2*10^7 forward dynamics: 20 s or more) within 5 s: the binding lets
+    # Python handle signals every 1000 periods.
+    import _thread
+    import threading
+    import time
+
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        simulate(lwr, Q0, QD0, 100.0, PDGravity(lwr, KP, KD, np.zeros(7)), substeps=50)
+    timer.join()
+    assert time.perf_counter() - start < 5.0
+
+
 # --- errors --------------------------------------------------------------------------------------
 
 

@@ -41,6 +41,25 @@ class PythonController : public Controller {
   int n_;
 };
 
+// Lets Ctrl-C stop a long run of a built-in controller: every kCheckPeriods periods it takes the
+// GIL for a moment and lets Python run its signal handlers (KeyboardInterrupt propagates).
+class Interruptible : public Controller {
+ public:
+  explicit Interruptible(Controller& inner) : inner_(inner) {}
+
+  void command(int k, double t, const VectorIn& q, const VectorIn& qd, VectorOut tau) override {
+    if (k % kCheckPeriods == kCheckPeriods - 1) {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
+    inner_.command(k, t, q, qd, tau);
+  }
+
+ private:
+  static constexpr int kCheckPeriods = 1000;
+  Controller& inner_;
+};
+
 Integrator parse_integrator(const std::string& method) {
   if (method == "rk4") return Integrator::RungeKutta4;
   if (method == "euler") return Integrator::SemiImplicitEuler;
@@ -124,9 +143,10 @@ void bind_simulator(py::module_& m) {
                              RowMajorMap(qdd.mutable_data(), rows, n),
                              RowMajorMap(tau.mutable_data(), rows, n),
                              RowMajorMap(q_measured.mutable_data(), q_measured.shape(0), n)};
+        Interruptible interruptible(*controller);
         {
           py::gil_scoped_release release;
-          simulator.run(*controller, Eigen::Map<const VectorX>(q0.data(), n),
+          simulator.run(interruptible, Eigen::Map<const VectorX>(q0.data(), n),
                         Eigen::Map<const VectorX>(qd0.data(), n), periods, out);
         }
         py::object measured = record_measured ? py::object(q_measured) : py::object(py::none());
