@@ -17,7 +17,9 @@ namespace dynid {
 
 enum class Integrator {
   RungeKutta4,        // classical fourth-order Runge-Kutta, global error O(h^4)
-  SemiImplicitEuler,  // qd += h qdd(q, qd); q += h qd (symplectic Euler), global error O(h)
+  // qd += h qdd(q, qd); q += h qd, global error O(h); symplectic (bounded energy error) when M
+  // is constant, nearly so otherwise (docs: simulation part of uses.md)
+  SemiImplicitEuler,
 };
 
 struct SimulationSettings {
