@@ -1,0 +1,129 @@
+"""Uniform time scaling of a trajectory: its torques from the stored ones, no dynamics recomputed.
+
+Notes ("Dynamic scaling of trajectories", pp. 37-40). A trajectory q_d(t), t in [0, T], is executed
+k times slower (k > 1) or faster (k < 1) as q_s(r) with r = k t in [0, kT], so that
+q_d(t) = q_s(kt): the same path, the same positions at the mapped instants, with
+q_s' = qd_d / k and q_s'' = qdd_d / k^2 (p. 37). The model is linear in the acceleration and
+quadratic in the velocity, so the inertial and Coriolis/centrifugal torque scales as 1/k^2 while
+gravity, depending on the position only, does not scale (p. 38):
+
+    tau_s(kt) = (tau_d(t) - g(q_d(t))) / k^2 + g(q_d(t)).
+
+The notes neglect dissipative terms there. With the drive terms of SPEC section 2
+(tau = (B + diag(Ia)) qdd + c + g + Fv qd + Fs sign(qd)) the rotor inertia is inertial and
+scales with the rest of the 1/k^2 part, viscous friction scales as 1/k and Coulomb friction,
+sign(qd / k) = sign(qd), not at all:
+
+    tau_s(kt) = (tau_d - g - Fv qd_d - Fs sign(qd_d)) / k^2 + g + Fv qd_d / k + Fs sign(qd_d),
+
+exact for every sample: only the stored total torque tau_d and gravity torque g are needed, plus
+the original velocity and the friction coefficients when the model has friction.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._checks import real_array
+from .robot import Robot
+
+
+def check_scale(k: Any) -> float:
+    """The time-scaling factor k > 0 and finite, as a float (``ValueError`` naming ``k``)."""
+    real = isinstance(k, (int, float, np.integer, np.floating)) and not isinstance(
+        k, (bool, np.bool_)
+    )
+    if not real or not np.isfinite(k) or k <= 0:
+        raise ValueError(
+            f"k: expected a finite time-scaling factor k > 0 (t' = k t: k > 1 slows down, "
+            f"k < 1 speeds up), got {k!r}"
+        )
+    return float(k)
+
+
+def scale_time(t: ArrayLike, k: float) -> NDArray[np.float64]:
+    """The scaled trajectory's time grid, t' = k t (notes p. 37, r(t) = k t).
+
+    Sample i of the original trajectory at t_i and sample i of the scaled one at k t_i share the
+    same position; a duration T becomes k T (notes p. 40: T = 0.5 s, k = 2 -> T' = 1 s).
+    """
+    k = check_scale(k)
+    return k * real_array(t, "t")
+
+
+def scale_motion(
+    qd: ArrayLike, qdd: ArrayLike, k: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Velocities and accelerations of the scaled trajectory at t' = k t: (qd / k, qdd / k^2).
+
+    The positions are the original ones (q_s(kt) = q_d(t)); notes p. 37.
+    """
+    k = check_scale(k)
+    qd = real_array(qd, "qd")
+    qdd = real_array(qdd, "qdd")
+    if qd.shape != qdd.shape:
+        raise ValueError(f"qdd: expected the shape of qd {qd.shape}, got {qdd.shape}")
+    return qd / k, qdd / k**2
+
+
+def scale_torques(
+    tau: ArrayLike,
+    tau_gravity: ArrayLike,
+    k: float,
+    *,
+    qd: ArrayLike | None = None,
+    robot: Robot | None = None,
+) -> NDArray[np.float64]:
+    """Torques of the trajectory executed with time scaled by k (t' = k t), from the stored ones.
+
+    Parameters
+    ----------
+    tau
+        (T, n) or (n,): the total torques stored along the original trajectory (inverse dynamics
+        or measured), including drive terms if the model has them.
+    tau_gravity
+        Same shape: the gravity torques g(q) at the same samples.
+    k
+        Scaling factor, finite and > 0: k > 1 slows down (the torque above gravity shrinks by
+        1/k^2), k < 1 speeds up. Sample i of the result belongs to time k t_i
+        (:func:`scale_time`).
+    qd, robot
+        Needed only when the torques contain friction: the original velocities (same shape as
+        ``tau``) and the robot whose ``Fv`` and ``Fs`` produced them. The rotor inertias ``Ia``
+        need nothing: being inertial, they scale with the 1/k^2 part. Without ``robot`` the
+        torques are taken as frictionless (notes p. 38, "dissipative terms neglected").
+
+    Returns
+    -------
+    The scaled torques, shape of ``tau``: (tau - g - f) / k^2 + g + Fv qd / k + Fs sign(qd)
+    with f = Fv qd + Fs sign(qd) (see the module docstring; notes p. 38).
+    """
+    k = check_scale(k)
+    tau = real_array(tau, "tau")
+    gravity = real_array(tau_gravity, "tau_gravity")
+    if tau.ndim not in (1, 2) or tau.size == 0:
+        raise ValueError(f"tau: expected shape (T, n) or (n,), got {tau.shape}")
+    if gravity.shape != tau.shape:
+        raise ValueError(f"tau_gravity: expected the shape of tau {tau.shape}, got {gravity.shape}")
+    if robot is None:
+        if qd is not None:
+            raise ValueError(
+                "robot: qd was given without the robot whose Fv, Fs produced the friction torques"
+            )
+        return (tau - gravity) / k**2 + gravity
+    if not isinstance(robot, Robot):
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+    if tau.shape[-1] != robot.n:
+        raise ValueError(f"tau: expected {robot.n} joints (robot.n) per sample, got {tau.shape}")
+    if qd is None:
+        raise ValueError("qd: the original velocities are needed to scale the friction torques")
+    qd = real_array(qd, "qd")
+    if qd.shape != tau.shape:
+        raise ValueError(f"qd: expected the shape of tau {tau.shape}, got {qd.shape}")
+    viscous = robot.Fv * qd
+    coulomb = robot.Fs * np.sign(qd)  # sign(qd / k) = sign(qd) for k > 0, sign(0) = 0
+    inertial = tau - gravity - viscous - coulomb  # (B + diag(Ia)) qdd + c: scales as 1/k^2
+    return inertial / k**2 + gravity + viscous / k + coulomb
