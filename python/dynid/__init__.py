@@ -10,6 +10,7 @@ checking the result (``validation``, ``plots``) and the command line (``cli``).
 from . import models
 from ._core import get_threads, set_threads
 from .base_parameters import BaseParameters, base_parameters
+from .bounds import DynamicBounds, dynamic_bounds
 from .cmake import get_cmake_dir, get_include
 from .excitation import FourierTrajectory, optimize_excitation
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
@@ -17,23 +18,29 @@ from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .io import Log, load_log, prepare_log, save_log
 from .log_identification import LogIdentification, identify_log, validate_log
 from .model_files import load_model, save_model
+from .payload import PayloadEstimate, estimate_payload
 from .recursive import RecursiveLeastSquares
 from .result_files import load_result
 from .robot import Robot
 from .sim import VirtualController
+from .time_scaling import scale_motion, scale_time, scale_torques
 
 __all__ = [
     "BaseParameters",
+    "DynamicBounds",
     "FourierTrajectory",
     "IdentifiedModel",
     "LeastSquaresResult",
     "Log",
     "LogIdentification",
+    "PayloadEstimate",
     "RankDeficientError",
     "RecursiveLeastSquares",
     "Robot",
     "VirtualController",
     "base_parameters",
+    "dynamic_bounds",
+    "estimate_payload",
     "get_cmake_dir",
     "get_include",
     "get_threads",
@@ -49,6 +56,9 @@ __all__ = [
     "prepare_log",
     "save_log",
     "save_model",
+    "scale_motion",
+    "scale_time",
+    "scale_torques",
     "set_threads",
     "validate_log",
 ]
