@@ -169,3 +169,63 @@ def test_bad_arrays_are_value_errors_naming_the_argument():
         scale_motion(np.ones((3, 2)), np.ones((3, 3)), 2.0)
     with pytest.raises(ValueError, match=r"^t: expected real numbers"):
         scale_time(["a", "b"], 2.0)
+
+
+# --- the slowest scaling needed for torque limits -----------------------------------------------
+
+
+@pytest.mark.parametrize("drives", ["with_drive_terms", "rigid_body"])
+def test_scaling_for_torque_limits_reaches_the_limit_exactly(drives):
+    # Independent check by brute force on scale_torques' output (itself checked against rnea
+    # above): at the returned k the largest |tau| / tau_max is 1 (1e-10), a 1e-6 faster motion
+    # violates it, and every slower one on a grid up to 100 k respects it.
+    from dynid.time_scaling import scaling_for_torque_limits
+    robot = dynid.models.kuka_lwr4()
+    if drives == "rigid_body":
+        robot = robot.rigid_body()
+    t = np.linspace(0.0, 2 * np.pi / 3.0, 400)
+    q, qd, qdd = sinusoids(t, 3.0, robot.n)
+    tau, g = robot.rnea(q, qd, qdd), robot.gravity(q)
+    tau_max = np.array([176.0, 176.0, 100.0, 100.0, 100.0, 38.0, 38.0]) / 4
+    k = scaling_for_torque_limits(tau, g, tau_max, qd=qd, robot=robot)
+
+    def ratio(k_: float) -> float:
+        return float((np.abs(scale_torques(tau, g, k_, qd=qd, robot=robot)) / tau_max).max())
+
+    assert ratio(1.0) > 1.0  # the original motion violates the limits: k > 1 needed
+    assert ratio(k) == pytest.approx(1.0, abs=1e-10)
+    assert ratio(k * (1 - 1e-6)) > 1.0
+    assert all(ratio(x) <= 1.0 + 1e-12 for x in k * np.geomspace(1.0, 100.0, 200))
+
+
+def test_scaling_for_torque_limits_on_the_notes_example_and_bad_limits():
+    # The notes' 2R cubic (p. 39), frictionless: (tau - g) / k^2 + g within the limits, a
+    # closed form per sample: k^2 = max (tau - g) / (+-limit - g) over the samples where the
+    # limit is approached. With a 10 N m limit on joint 1 (and a loose one on joint 2) this is
+    # checked against that formula (1e-12); a limit below the final gravity torque is refused.
+    from dynid.time_scaling import scaling_for_torque_limits
+    robot = dynid.models.planar_2r(m1=0.26, m2=0.26)
+    t = np.linspace(0.0, 0.5, 501)
+    q, qd, qdd = cubic(t, 0.5)
+    tau, g = robot.rnea(q, qd, qdd), robot.gravity(q)
+    limits = np.array([10.0, 1e3])
+    dyn = tau - g
+    bound = np.where(dyn > 0, limits - g, -limits - g)  # the side the dynamic part pushes to
+    expected = np.sqrt((dyn / bound).max())
+    assert scaling_for_torque_limits(tau, g, limits) == pytest.approx(expected, rel=1e-12)
+    assert scaling_for_torque_limits(tau, g, 1e4) < 1.0  # loose limits: may speed up
+    with pytest.raises(ValueError, match=r"^tau_max: the gravity .* no time scaling"):
+        scaling_for_torque_limits(tau, g, [0.5, 1e3])
+    with pytest.raises(ValueError, match=r"^tau_max: expected a positive limit per joint"):
+        scaling_for_torque_limits(tau, g, [1.0, 0.0])
+    with pytest.raises(ValueError, match=r"^tau_max: expected a positive limit per joint"):
+        scaling_for_torque_limits(tau, g, [1.0, 2.0, 3.0])
+
+
+def test_extreme_factors_do_not_overflow():
+    # k = 1e200: k^2 overflows a float; the result is the gravity torque (exact), and k = 1e-100
+    # multiplies the dynamic part by 1e200 (finite here).
+    tau, g = np.array([[3.0, -2.0]]), np.array([[1.0, 0.5]])
+    np.testing.assert_array_equal(scale_torques(tau, g, 1e200), g)
+    np.testing.assert_allclose(scale_torques(tau, g, 1e-100), (tau - g) * 1e200 + g, rtol=1e-15)
+    np.testing.assert_array_equal(scale_motion(tau, tau, 1e200)[1], np.zeros((1, 2)))

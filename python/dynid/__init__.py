@@ -23,7 +23,7 @@ from .recursive import RecursiveLeastSquares
 from .result_files import load_result
 from .robot import Robot
 from .sim import VirtualController
-from .time_scaling import scale_motion, scale_time, scale_torques
+from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 __all__ = [
     "BaseParameters",
@@ -59,6 +59,7 @@ __all__ = [
     "scale_motion",
     "scale_time",
     "scale_torques",
+    "scaling_for_torque_limits",
     "set_threads",
     "validate_log",
 ]

@@ -66,7 +66,7 @@ def scale_motion(
     qdd = real_array(qdd, "qdd")
     if qd.shape != qdd.shape:
         raise ValueError(f"qdd: expected the shape of qd {qd.shape}, got {qdd.shape}")
-    return qd / k, qdd / k**2
+    return qd / k, qdd / k / k
 
 
 def scale_torques(
@@ -102,6 +102,14 @@ def scale_torques(
     with f = Fv qd + Fs sign(qd) (see the module docstring; notes p. 38).
     """
     k = check_scale(k)
+    constant, viscous, inertial = _parts(tau, tau_gravity, qd, robot)
+    return inertial / k / k + viscous / k + constant  # k * k could overflow for huge k
+
+
+def _parts(
+    tau: ArrayLike, tau_gravity: ArrayLike, qd: ArrayLike | None, robot: Robot | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The stored torque split by how it scales: (g + Fs sign(qd), Fv qd, the inertial rest)."""
     tau = real_array(tau, "tau")
     gravity = real_array(tau_gravity, "tau_gravity")
     if tau.ndim not in (1, 2) or tau.size == 0:
@@ -113,7 +121,7 @@ def scale_torques(
             raise ValueError(
                 "robot: qd was given without the robot whose Fv, Fs produced the friction torques"
             )
-        return (tau - gravity) / k**2 + gravity
+        return gravity, np.zeros_like(tau), tau - gravity
     if not isinstance(robot, Robot):
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if tau.shape[-1] != robot.n:
@@ -126,4 +134,61 @@ def scale_torques(
     viscous = robot.Fv * qd
     coulomb = robot.Fs * np.sign(qd)  # sign(qd / k) = sign(qd) for k > 0, sign(0) = 0
     inertial = tau - gravity - viscous - coulomb  # (B + diag(Ia)) qdd + c: scales as 1/k^2
-    return inertial / k**2 + gravity + viscous / k + coulomb
+    return gravity + coulomb, viscous, inertial
+
+
+def scaling_for_torque_limits(
+    tau: ArrayLike,
+    tau_gravity: ArrayLike,
+    tau_max: ArrayLike,
+    *,
+    qd: ArrayLike | None = None,
+    robot: Robot | None = None,
+) -> float:
+    """The smallest k such that the trajectory scaled by any k' >= k respects |tau| <= tau_max.
+
+    Notes p. 39: the original motion (T = 0.5 s) "maybe violates the torque limit at joint 1";
+    slowing it down by k shrinks the torque above gravity. With s = 1/k the scaled torque of each
+    sample and joint is h(s) = a + b s + d s^2 (:func:`scale_torques`: a = g + Fs sign(qd),
+    b = Fv qd, d = the inertial part), so k = 1 / s* with s* the first s > 0 at which some
+    |h(s)| reaches tau_max (a root of a quadratic per sample and joint); every slower scaling
+    (s < s*) stays within the limits. The result may be below 1: the motion can then be sped up.
+
+    Parameters are those of :func:`scale_torques`, plus ``tau_max``: (n,) positive torque limits
+    (or a scalar for all joints). Raises ValueError naming ``tau_max`` when even an infinitely
+    slow motion violates them (|g + Fs sign(qd)| > tau_max at some sample). Returns 0.0 when no
+    speed reaches the limits (the torques do not grow with the speed).
+    """
+    a, b, d = _parts(tau, tau_gravity, qd, robot)  # h(s) = a + b s + d s^2, s = 1/k
+    n = a.shape[-1]
+    limits = real_array(tau_max, "tau_max")
+    if limits.ndim > 1 or (limits.ndim == 1 and limits.shape != (n,)) or np.any(limits <= 0):
+        raise ValueError(
+            f"tau_max: expected a positive limit per joint, shape ({n},) or a scalar, got "
+            f"{limits!r}"
+        )
+    if np.any(np.abs(a) > limits):
+        index = tuple(int(i[0]) for i in np.nonzero(np.abs(a) > limits))
+        raise ValueError(
+            f"tau_max: the gravity (and Coulomb friction) torque alone exceeds the limit at "
+            f"sample/joint {index}: no time scaling can respect it"
+        )
+    first = np.full(a.shape, np.inf)
+    for bound in (limits, -limits):  # first positive root of d s^2 + b s + (a - bound) = 0
+        first = np.minimum(first, _first_positive_root(d, b, a - bound))
+    s_star = float(first.min())
+    return 0.0 if s_star == np.inf else 1.0 / s_star
+
+
+def _first_positive_root(
+    d: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Elementwise smallest root s > 0 of d s^2 + b s + c = 0 (inf where there is none)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        disc = b * b - 4.0 * d * c
+        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        # Numerically stable pair: q = -(b + sign(b) sqrt(disc)) / 2, roots q / d and c / q.
+        qv = -0.5 * (b + np.where(b >= 0, 1.0, -1.0) * root)
+        candidates = np.stack([qv / d, c / qv, np.where(d == 0, -c / b, np.nan)])
+    candidates = np.where(np.isfinite(candidates) & (candidates > 0), candidates, np.inf)
+    return candidates.min(axis=0)
