@@ -106,12 +106,12 @@ def dynamic_bounds(
     for k4, the unit velocity) attaining it. See the module docstring: estimates, not guarantees.
     """
     if not isinstance(robot, Robot):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")  # noqa: TRY004 -- SPEC 2
     per_start = count(samples_per_start, "samples_per_start", 1)
     samples = count(samples, "samples", per_start,
                     "at least one block of samples_per_start samples")
     if not isinstance(optimize, (bool, np.bool_)):
-        raise ValueError(f"optimize: expected True or False, got {optimize!r}")
+        raise ValueError(f"optimize: expected True or False, got {optimize!r}")  # noqa: TRY004
     seed = count(seed, "seed", 0)
     n = robot.n
     low, high = robot.qlim[:, 0], robot.qlim[:, 1]

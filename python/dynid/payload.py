@@ -120,9 +120,9 @@ def estimate_payload(
     arguments.
     """
     if not isinstance(robot, Robot):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")  # noqa: TRY004 -- SPEC 2
     if not isinstance(inertia, (bool, np.bool_)):
-        raise ValueError(f"inertia: expected True or False, got {inertia!r}")
+        raise ValueError(f"inertia: expected True or False, got {inertia!r}")  # noqa: TRY004
     if not isinstance(frame, str) or frame not in FRAMES:
         raise ValueError(f"frame: expected one of {FRAMES}, got {frame!r}")
     q, qd, qdd, tau = (_samples(value, name, robot.n) for value, name in

@@ -123,7 +123,7 @@ def _parts(
             )
         return gravity, np.zeros_like(tau), tau - gravity
     if not isinstance(robot, Robot):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")  # noqa: TRY004 -- SPEC 2
     if tau.shape[-1] != robot.n:
         raise ValueError(f"tau: expected {robot.n} joints (robot.n) per sample, got {tau.shape}")
     if qd is None:
