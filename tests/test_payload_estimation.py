@@ -243,9 +243,10 @@ def test_the_mass_equals_the_papers_eqs_31_32_on_the_papers_setting(noise):
     # coefficients holding d1 and d2 (payload_mass_estimates). Here: the rule of change on the
     # same static data, tau_unloaded = the identified unloaded model's g(q), inertia=False.
     # Noise-free all three agree with 0.25 kg to 1e-9; with the demo noise (model 1e-5 relative,
-    # position 1e-5 rad) all within 1 % of 0.25 kg and of each other. (Not "within 3 std": the
-    # std covers the loaded data's noise, not the error of the identified unloaded model, which
-    # here is of the same size: observed 0.2500036 +- 0.0000013 kg.)
+    # position 1e-5 rad) all within 1 % of 0.25 kg and within 5e-4 relative of each other
+    # (observed: 0.2500093 and 0.2499990 from eqs. (31), (32), 0.2500036 here). Not "within 3
+    # std": the std covers the loaded data's noise, not the error of the identified unloaded
+    # model, which here is of the same size (+- 0.0000013 kg).
     structure, truth = dynid.models.kuka_lwr4(), controller_model()
     q = truth.random_configurations(1000, seed=6)
     options = {"model_noise": 1e-5 * noise, "position_noise": 1e-5 * noise}
@@ -270,7 +271,7 @@ def test_the_mass_equals_the_papers_eqs_31_32_on_the_papers_setting(noise):
         assert est.mass == pytest.approx(TIP_MASS, rel=0.01)
         for e in paper:
             assert e["mass"] == pytest.approx(TIP_MASS, rel=0.01)
-            assert e["mass"] == pytest.approx(est.mass, rel=0.01)
+            assert e["mass"] == pytest.approx(est.mass, rel=5e-4)
 
 
 @pytest.mark.parametrize(
