@@ -13,8 +13,9 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
 4. the stacked system is solved by OLS or WLS (``dynid.identify.least_squares``).
 
 The result predicts torques on any log (``predict``), is checked on another log
-(:func:`validate_log`) and is saved to a folder (JSON with everything needed to apply it again,
-including the model's DH table, plus PNG plots) and loaded back (:func:`load_result`).
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result` (JSON with everything needed
+to apply it again, including the model's DH table, plus PNG plots) and loaded back by
+:func:`dynid.load_result`.
 """
 
 from __future__ import annotations
@@ -27,10 +28,12 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
+from ._equality import ValueEquality
 from .base_parameters import base_parameters
 from .identify import least_squares
-from .io import Log, prepare_log
-from .model_files import model_from_dict, model_to_dict
+from .io.log_files import Log
+from .io.model_files import model_from_dict, model_to_dict
+from .io.preparation import prepare_log
 from .robot import Robot
 from .validation import error_metrics, validation_table
 
@@ -45,7 +48,7 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 
 @dataclass(eq=False)
-class LogIdentification:
+class LogIdentification(ValueEquality):
     """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
@@ -55,7 +58,7 @@ class LogIdentification:
     preparation (options and notes, in words) and per-joint fit metrics.
     """
 
-    model: dict[str, Any]  #: the robot model (``dynid.model_files`` format): DH table etc.
+    model: dict[str, Any]  #: the robot model (``dynid.io.model_files`` format): DH table etc.
     rotor: bool
     friction: bool
     offset: bool
@@ -72,8 +75,9 @@ class LogIdentification:
     rank: int
     excluded: tuple[int, ...] = ()
     training: dict[str, Any] = field(default_factory=dict)
-    log: Log | None = field(default=None, repr=False)  #: the prepared training log (not saved)
-    _robot: Robot | None = field(default=None, repr=False)
+    #: the prepared training log (not saved, not compared)
+    log: Log | None = field(default=None, repr=False, compare=False)
+    _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
     def n(self) -> int:
@@ -142,15 +146,6 @@ class LogIdentification:
             text += validation_table(arrays)
         return text
 
-    def save(self, folder: PathLike, log: Log | None = None, plots: bool = True) -> Path:
-        """Write ``result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of the
-        fit on ``log`` (default: the training log, when kept) into ``folder``; returns the JSON
-        path."""
-        from .result_files import save_result
-
-        log = log if log is not None else self.log
-        return save_result(self, folder, log if plots else None)
-
 
 def identify_log(
     log: Log,
@@ -215,22 +210,47 @@ def identify_log(
     return result
 
 
+@dataclass(eq=False)
+class LogValidation(ValueEquality):
+    """An identified model applied to another log: the prepared log, the predicted torques and
+    the per-joint errors (:func:`dynid.validation.error_metrics`)."""
+
+    log: Log  #: the validation log after ``preparation``
+    predicted: NDArray[np.float64]
+    metrics: dict[str, NDArray[np.float64]]
+    preparation: dict[str, Any]
+    notes: list[str] = field(default_factory=list)  #: differences from the training preparation
+
+
+def run_validation(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> LogValidation:
+    """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
+    and measure the errors; ``notes`` says where the preparation differs from the training
+    log's (a low-pass on one and not the other biases the comparison)."""
+    options = _options(preparation)
+    prepared = prepare_log(log, **options) if options else log
+    predicted = result.predict(prepared)
+    notes = []
+    trained = result.training.get("preparation", {}).get("cutoff")
+    if trained != options.get("cutoff"):
+        notes.append(f"the training log was {_filtered(trained)}, this one is "
+                     f"{_filtered(options.get('cutoff'))}")
+    return LogValidation(prepared, predicted, error_metrics(prepared.tau, predicted), options,
+                         notes)
+
+
 def validate_log(
     result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
 ) -> dict[str, NDArray[np.float64]]:
     """Per-joint errors of ``result`` on another log (``prepare_log(log, **preparation)``
     first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
     ``r2`` and ``mse`` (see :func:`dynid.validation.error_metrics`)."""
-    options = _options(preparation)
-    prepared = prepare_log(log, **options) if options else log
-    return error_metrics(prepared.tau, result.predict(prepared))
+    return run_validation(result, log, preparation=preparation).metrics
 
 
-def load_result(path: PathLike) -> LogIdentification:
-    """A result saved by :meth:`LogIdentification.save`: its folder or its ``result.json``."""
-    from .result_files import load_result as _load
-
-    return _load(path)
+def _filtered(cutoff: float | None) -> str:
+    return "not low-passed" if cutoff is None else f"low-passed at {cutoff:g} Hz"
 
 
 def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:

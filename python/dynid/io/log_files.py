@@ -4,7 +4,7 @@ A :class:`Log` holds time, joint positions and joint torques, with velocities an
 when the recording has them. Files are NPZ or CSV, laid out as in ``docs/data.md``; the
 FloBaRoID key names of the real KUKA LWR4+ recordings (``times``, ``positions``, ...) are read as
 they are. Preparing a log for identification (filtering, differentiation, decimation, dropping
-samples) is :mod:`dynid.preparation`; :func:`prepare_log` is re-exported here.
+samples) is :mod:`dynid.io.preparation`.
 """
 
 from __future__ import annotations
@@ -19,8 +19,9 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import signal as sig
-from ._checks import real_array
+from .. import signal as sig
+from .._checks import count, is_integer, real_array
+from .._equality import ValueEquality
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -40,7 +41,7 @@ PathLike = Union[str, Path]
 
 
 @dataclass(eq=False, repr=False)
-class Log:
+class Log(ValueEquality):
     """A measurement log: t (T,), q and tau (T, n), optional qd and qdd (T, n).
 
     ``t`` is kept as recorded (it may start anywhere, e.g. at a Unix time). ``notes`` lists, in
@@ -145,6 +146,9 @@ class Log:
                 raise ValueError(f"mask: expected a boolean array of shape ({self.T},), got {mask.shape}")
             kept = int(mask.sum())
         elif np.issubdtype(mask.dtype, np.integer) and mask.ndim == 1:
+            if mask.size and (mask.min() < 0 or mask.max() >= self.T):
+                raise ValueError(f"mask: sample indices must lie in [0, {self.T}), got "
+                                 f"{mask.min()}..{mask.max()}")
             kept = mask.size
         else:
             raise ValueError(
@@ -160,8 +164,7 @@ class Log:
               note: str | None = None) -> Log:
         """Samples start:stop (Python slice semantics, negative indices allowed)."""
         for name, value in (("start", start), ("stop", stop)):
-            if value is not None and (isinstance(value, bool)
-                                      or not isinstance(value, (int, np.integer))):
+            if value is not None and not is_integer(value):
                 raise ValueError(f"{name}: expected an integer or None, got {value!r}")
         lo, hi, _ = slice(start, stop).indices(self.T)
         if note is None:
@@ -211,8 +214,7 @@ def load_log(path: PathLike, *, skip: int = 0) -> Log:
     suffix = path.suffix.lower()
     if suffix not in (".npz", ".csv"):
         raise ValueError(f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv")
-    if isinstance(skip, bool) or not isinstance(skip, (int, np.integer)) or skip < 0:
-        raise ValueError(f"skip: expected a non-negative integer, got {skip!r}")
+    skip = count(skip, "skip", 0)
     try:
         log = _load_npz(path) if suffix == ".npz" else _load_csv(path)
     except ValueError as exc:
@@ -231,6 +233,7 @@ def _load_npz(path: Path) -> Log:
         raise ValueError(f"not a readable NPZ file ({type(exc).__name__}: {exc})") from None
     with data:
         found = list(data.files)
+        _check_npz_members(path)
         arrays: dict[str, Any] = {}
         flobaroid = False
         for name, aliases in NPZ_KEYS.items():
@@ -256,6 +259,30 @@ def _load_npz(path: Path) -> Log:
     how = "FloBaRoID key names" if flobaroid else "dynid key names"
     note = f"loaded from {path.name} (NPZ, {how}; {', '.join(arrays)})"
     return Log(**arrays, source=str(path), notes=notes + [note])
+
+
+def _check_npz_members(path: Path) -> None:
+    """Refuse a member whose .npy header asks for more bytes than the member holds (a corrupt or
+    hostile header would otherwise make NumPy try to allocate it) or that is not .npy at all."""
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            if not info.filename.endswith(".npy"):
+                raise ValueError(f"member {info.filename!r} is not a .npy array")
+            with archive.open(info) as member:
+                try:
+                    version = np.lib.format.read_magic(member)
+                    read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                            else np.lib.format.read_array_header_2_0)
+                    shape, _, dtype = read(member)
+                except (ValueError, OSError, EOFError) as exc:
+                    raise ValueError(f"member {info.filename!r}: unreadable header ({exc})"
+                                     ) from None
+            needed = dtype.itemsize * int(np.prod(shape, dtype=object))
+            if needed > info.file_size:
+                raise ValueError(
+                    f"member {info.filename!r}: its header asks for shape {shape} "
+                    f"({needed} bytes) but the member holds {info.file_size} bytes"
+                )
 
 
 _CSV_COLUMN = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
@@ -395,7 +422,3 @@ def save_log(log: Log, path: PathLike) -> None:
     else:
         raise ValueError(f"path: unknown extension {path.suffix!r}; expected .npz or .csv")
 
-
-# Preparation builds on Log; imported last so that dynid.io.prepare_log stays where it was
-# (dynid.preparation imports Log from here).
-from .preparation import prepare_log  # noqa: F401
