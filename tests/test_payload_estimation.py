@@ -285,7 +285,7 @@ def test_the_mass_equals_the_papers_eqs_31_32_on_the_papers_setting(noise):
         ({"inertia": "yes"}, r"^inertia: expected True or False"),
         ({"frame": "world"}, r"^frame: expected one of"),
         ({"method": "ridge"}, r"^method: expected one of"),
-        ({"exclude_joints": (7,)}, r"^exclude_joints: expected 0-based joint indices"),
+        ({"exclude_joints": (7,)}, r"^exclude_joints: expected .*\[0, 7\)"),
         ({"qdd": [[1j] * 7] * 10}, r"^qdd: expected real numbers"),
     ],
 )

@@ -32,10 +32,10 @@ from .robot import Robot
 
 if TYPE_CHECKING:
     from . import models
+    from .bounds import DynamicBounds, dynamic_bounds
     from .cmake import get_cmake_dir, get_include
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
-    from .bounds import DynamicBounds, dynamic_bounds
     from .identify import LeastSquaresResult, RankDeficientError, least_squares
     from .io.log_files import Log, load_log, save_log
     from .io.model_files import load_model, save_model
