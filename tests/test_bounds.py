@@ -157,3 +157,12 @@ def test_bad_arguments_are_value_errors_naming_them(kwargs, match):
     robot = args.pop("robot")
     with pytest.raises(ValueError, match=match):
         dynamic_bounds(robot, **args)
+
+
+def test_results_compare_by_value():
+    # Same arguments, same seed: equal results (arrays compared element by element, no
+    # "ambiguous truth value"); another seed differs.
+    robot = dynid.models.planar_2r()
+    a, b = dynamic_bounds(robot, 500, seed=1), dynamic_bounds(robot, 500, seed=1)
+    assert a == b and a.k4 == b.k4
+    assert a != dynamic_bounds(robot, 500, seed=2)

@@ -296,3 +296,14 @@ def test_bad_arguments_are_value_errors_naming_them(change, match):
     with pytest.raises(ValueError, match=match):
         estimate_payload(args.pop("robot"), args.pop("q"), args.pop("qd"), args.pop("qdd"),
                          args.pop("tau"), **args)
+
+
+def test_results_compare_by_value():
+    # The same data give equal estimates (arrays compared by value, None fields included).
+    robot = dynid.models.kuka_lwr4()
+    q, qd, qdd = random_states(robot, 50, seed=0)
+    tau = robot.with_payload(*PAYLOADS["offset_body"]).rnea(q, qd, qdd)
+    assert estimate_payload(robot, q, qd, qdd, tau) == estimate_payload(robot, q, qd, qdd, tau)
+    empty = estimate_payload(robot, q, qd, qdd, robot.rnea(q, qd, qdd))
+    assert empty == estimate_payload(robot, q, qd, qdd, robot.rnea(q, qd, qdd))
+    assert empty != estimate_payload(robot, q, qd, qdd, tau)

@@ -41,6 +41,7 @@ import scipy.optimize
 from numpy.typing import NDArray
 
 from ._checks import count
+from ._equality import ValueEquality
 from .robot import Robot
 
 #: L-BFGS-B settings of the local refinement: tight, the functions are cheap and smooth away from
@@ -48,8 +49,8 @@ from .robot import Robot
 _OPTIONS = {"ftol": 1e-15, "gtol": 1e-12, "maxiter": 500}
 
 
-@dataclass(frozen=True)
-class BoundEstimate:
+@dataclass(frozen=True, eq=False)
+class BoundEstimate(ValueEquality):
     """One constant: its estimate and where it is attained."""
 
     value: float  #: the estimate (sampled, then locally refined)
@@ -58,8 +59,8 @@ class BoundEstimate:
     qd: NDArray[np.float64] | None  #: (n,) unit velocity attaining it (k4 only)
 
 
-@dataclass(frozen=True)
-class DynamicBounds:
+@dataclass(frozen=True, eq=False)
+class DynamicBounds(ValueEquality):
     """Estimates of the notes' k0, k1, k4, k6 (p. 4) over ``qlim``; see :func:`dynamic_bounds`."""
 
     k0: BoundEstimate  #: min_q lambda_min(M(q))

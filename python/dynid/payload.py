@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._checks import real_array
+from ._equality import ValueEquality
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .robot import PARAMETER_FIELDS, Robot
 
@@ -47,8 +48,8 @@ FRAMES = ("flange", "tool")
 _ROWS, _COLS = np.array([0, 0, 0, 1, 1, 2]), np.array([0, 1, 2, 1, 2, 2])
 
 
-@dataclass(frozen=True)
-class PayloadEstimate:
+@dataclass(frozen=True, eq=False)
+class PayloadEstimate(ValueEquality):
     """A payload's inertial parameters estimated by :func:`estimate_payload`.
 
     ``com`` and ``inertia`` are in ``frame`` (the last DH frame n, "flange", or the robot's tool
