@@ -218,6 +218,14 @@ def test_a_planar_arm_cannot_see_the_out_of_plane_parameters():
     assert "m_L" not in least and "Izz_L" not in least
 
 
+def test_too_few_samples_is_a_clear_error():
+    # One sample of 7 joints: 7 equations for 10 unknowns.
+    robot = dynid.models.kuka_lwr4()
+    q = np.full(7, 0.3)
+    with pytest.raises(dynid.RankDeficientError, match=r"^q: 1 sample\(s\) give 7 torque equations"):
+        estimate_payload(robot, q, q, q, robot.rnea(q, q, q))
+
+
 def test_static_data_need_inertia_false():
     # qd = qdd = 0: the inertia does not act; the error says so and inertia=False recovers m and
     # c exactly (1e-9); inertia=False with moving data is refused.
@@ -286,6 +294,7 @@ def test_the_mass_equals_the_papers_eqs_31_32_on_the_papers_setting(noise):
         ({"frame": "world"}, r"^frame: expected one of"),
         ({"method": "ridge"}, r"^method: expected one of"),
         ({"exclude_joints": (7,)}, r"^exclude_joints: expected .*\[0, 7\)"),
+        ({"exclude_joints": 3}, r"^exclude_joints: expected"),
         ({"qdd": [[1j] * 7] * 10}, r"^qdd: expected real numbers"),
     ],
 )

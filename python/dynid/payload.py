@@ -149,6 +149,12 @@ def estimate_payload(
     columns = 10 if inertia else 4
     Y = robot.regressor(q, qd, qdd)[..., 10 * (robot.n - 1):10 * (robot.n - 1) + columns]
     names = list(PAYLOAD_NAMES[:columns])
+    rows = shape[0] * (robot.n - _count_excluded(exclude_joints, robot.n))
+    if rows < columns:
+        raise RankDeficientError(
+            f"q: {shape[0]} sample(s) give {rows} torque equations for the {columns} payload "
+            "parameters; use many more samples (a well-excited trajectory)"
+        )
     try:
         fit = least_squares(Y, tau - tau_unloaded, method=method, exclude_joints=exclude_joints,
                             names=names)
@@ -242,6 +248,15 @@ def _symmetric(six: NDArray[np.float64]) -> NDArray[np.float64]:
     out[_ROWS, _COLS] = six
     out[_COLS, _ROWS] = six
     return out
+
+
+def _count_excluded(exclude_joints: object, n: int) -> int:
+    """How many valid joints ``exclude_joints`` leaves out (least_squares reports bad ones)."""
+    try:
+        return len({int(j) for j in exclude_joints  # type: ignore[attr-defined]
+                    if isinstance(j, (int, np.integer)) and 0 <= j < n})
+    except TypeError:
+        return 0
 
 
 def _samples(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:
