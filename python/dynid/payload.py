@@ -95,7 +95,8 @@ def estimate_payload(
     robot
         The model of the unloaded arm: its kinematics (DH, gravity, tool) give Y_n and, unless
         ``tau_unloaded`` is given, ``robot.rnea(q, qd, qdd)`` (drive terms included) is the
-        unloaded torque.
+        unloaded torque; pass ``robot.rigid_body()`` for link-side torques without the drive
+        terms (e.g. the LWR's joint torque sensors, paper eq. (7)).
     q, qd, qdd, tau
         (T, n) samples of the loaded arm: positions, velocities, accelerations and the measured
         joint torques (or one sample (n,)).
