@@ -138,7 +138,7 @@ def test_notes_example_2r_slowed_from_half_a_second_to_one_second():
 # --- bad input ----------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("k", [0.0, -1.0, np.nan, np.inf, -np.inf, True, "2", None, 1j])
+@pytest.mark.parametrize("k", [0.0, -1.0, np.nan, np.inf, -np.inf, True, "2", None, 1j, 10**400])
 def test_bad_k_is_a_value_error_naming_k(k):
     tau = np.ones((3, 2))
     for call in (lambda: scale_torques(tau, tau, k), lambda: scale_time([0.0, 1.0], k),
@@ -230,3 +230,9 @@ def test_extreme_factors_do_not_overflow():
     np.testing.assert_array_equal(scale_torques(tau, g, 1e200), g)
     np.testing.assert_allclose(scale_torques(tau, g, 1e-100), (tau - g) * 1e200 + g, rtol=1e-15)
     np.testing.assert_array_equal(scale_motion(tau, tau, 1e200)[1], np.zeros((1, 2)))
+    with pytest.raises(ValueError, match=r"^k: k t overflows"):
+        scale_time([0.0, 1e10], 1e300)
+    with pytest.raises(ValueError, match=r"^k: the scaled values overflow"):
+        scale_torques(tau, g, 1e-200)
+    with pytest.raises(ValueError, match=r"^k: the scaled values overflow"):
+        scale_motion(tau, tau, 1e-200)

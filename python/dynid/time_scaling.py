@@ -36,12 +36,16 @@ def check_scale(k: Any) -> float:
     real = isinstance(k, (int, float, np.integer, np.floating)) and not isinstance(
         k, (bool, np.bool_)
     )
-    if not real or not np.isfinite(k) or k <= 0:
+    try:
+        value = float(k) if real else np.nan
+    except OverflowError:  # a Python int beyond float range
+        value = np.inf
+    if not np.isfinite(value) or value <= 0:
         raise ValueError(
             f"k: expected a finite time-scaling factor k > 0 (t' = k t: k > 1 slows down, "
             f"k < 1 speeds up), got {k!r}"
         )
-    return float(k)
+    return value
 
 
 def scale_time(t: ArrayLike, k: float) -> NDArray[np.float64]:
@@ -51,7 +55,12 @@ def scale_time(t: ArrayLike, k: float) -> NDArray[np.float64]:
     same position; a duration T becomes k T (notes p. 40: T = 0.5 s, k = 2 -> T' = 1 s).
     """
     k = check_scale(k)
-    return k * real_array(t, "t")
+    times = real_array(t, "t")
+    with np.errstate(over="ignore"):
+        scaled = k * times
+    if not np.all(np.isfinite(scaled)):
+        raise ValueError(f"k: k t overflows float64 (k = {k!r}, max |t| = {np.abs(times).max():g})")
+    return scaled
 
 
 def scale_motion(
@@ -66,7 +75,14 @@ def scale_motion(
     qdd = real_array(qdd, "qdd")
     if qd.shape != qdd.shape:
         raise ValueError(f"qdd: expected the shape of qd {qd.shape}, got {qdd.shape}")
-    return qd / k, qdd / k / k
+    with np.errstate(over="ignore"):
+        return _finite(qd / k, k), _finite(qdd / k / k, k)
+
+
+def _finite(scaled: NDArray[np.float64], k: float) -> NDArray[np.float64]:
+    if not np.all(np.isfinite(scaled)):
+        raise ValueError(f"k: the scaled values overflow float64 (k = {k!r} is too small)")
+    return scaled
 
 
 def scale_torques(
@@ -103,7 +119,9 @@ def scale_torques(
     """
     k = check_scale(k)
     constant, viscous, inertial = _parts(tau, tau_gravity, qd, robot)
-    return inertial / k / k + viscous / k + constant  # k * k could overflow for huge k
+    with np.errstate(over="ignore"):
+        scaled = inertial / k / k + viscous / k + constant  # k * k could overflow for huge k
+    return _finite(scaled, k)
 
 
 def _parts(
