@@ -11,6 +11,7 @@ one way from the model to the files:
   paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
   :mod:`~dynid.recursive`;
 - checking the result: :mod:`~dynid.validation`, :mod:`~dynid.plots`;
+- uses of the model: :mod:`~dynid.time_scaling`, :mod:`~dynid.bounds`, :mod:`~dynid.payload`;
 - files: :mod:`dynid.io` (model and result files); the command line: :mod:`dynid.cli`.
 
 Names are loaded on first use (PEP 562), so ``import dynid`` stays fast: SciPy's optimisers and
