@@ -40,6 +40,7 @@ import numpy as np
 import scipy.optimize
 from numpy.typing import NDArray
 
+from . import _checks as checks
 from ._checks import count
 from ._equality import ValueEquality
 from .robot import Robot
@@ -111,8 +112,7 @@ def dynamic_bounds(
     per_start = count(samples_per_start, "samples_per_start", 1)
     samples = count(samples, "samples", per_start,
                     "at least one block of samples_per_start samples")
-    if not isinstance(optimize, (bool, np.bool_)):
-        raise ValueError(f"optimize: expected True or False, got {optimize!r}")  # noqa: TRY004
+    optimize = checks.flag(optimize, "optimize")
     seed = count(seed, "seed", 0)
     n = robot.n
     low, high = robot.qlim[:, 0], robot.qlim[:, 1]

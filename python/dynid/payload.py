@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _checks as checks
 from ._checks import real_array
 from ._equality import ValueEquality
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
@@ -121,10 +122,9 @@ def estimate_payload(
     (e.g. the inertia from static data, or what a planar arm cannot see); ValueError for bad
     arguments.
     """
-    if not isinstance(robot, Robot):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")  # noqa: TRY004 -- SPEC 2
-    if not isinstance(inertia, (bool, np.bool_)):
-        raise ValueError(f"inertia: expected True or False, got {inertia!r}")  # noqa: TRY004
+    checks.robot(robot)
+    inertia = checks.flag(inertia, "inertia")
+    exclude_joints = checks.indices(exclude_joints, "exclude_joints", robot.n)
     if not isinstance(frame, str) or frame not in FRAMES:
         raise ValueError(f"frame: expected one of {FRAMES}, got {frame!r}")
     q, qd, qdd, tau = (_samples(value, name, robot.n) for value, name in
@@ -150,7 +150,7 @@ def estimate_payload(
     columns = 10 if inertia else 4
     Y = robot.regressor(q, qd, qdd)[..., 10 * (robot.n - 1):10 * (robot.n - 1) + columns]
     names = list(PAYLOAD_NAMES[:columns])
-    rows = shape[0] * (robot.n - _count_excluded(exclude_joints, robot.n))
+    rows = shape[0] * (robot.n - len(exclude_joints))
     if rows < columns:
         raise RankDeficientError(
             f"q: {shape[0]} sample(s) give {rows} torque equations for the {columns} payload "
@@ -249,15 +249,6 @@ def _symmetric(six: NDArray[np.float64]) -> NDArray[np.float64]:
     out[_ROWS, _COLS] = six
     out[_COLS, _ROWS] = six
     return out
-
-
-def _count_excluded(exclude_joints: object, n: int) -> int:
-    """How many valid joints ``exclude_joints`` leaves out (least_squares reports bad ones)."""
-    try:
-        return len({int(j) for j in exclude_joints  # type: ignore[attr-defined]
-                    if isinstance(j, (int, np.integer)) and 0 <= j < n})
-    except TypeError:
-        return 0
 
 
 def _samples(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _checks as checks
 from ._checks import real_array
 from .robot import Robot
 
@@ -140,8 +141,7 @@ def _parts(
                 "robot: qd was given without the robot whose Fv, Fs produced the friction torques"
             )
         return gravity, np.zeros_like(tau), tau - gravity
-    if not isinstance(robot, Robot):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")  # noqa: TRY004 -- SPEC 2
+    checks.robot(robot)
     if tau.shape[-1] != robot.n:
         raise ValueError(f"tau: expected {robot.n} joints (robot.n) per sample, got {tau.shape}")
     if qd is None:
