@@ -316,3 +316,75 @@ def test_results_compare_by_value():
     empty = estimate_payload(robot, q, qd, qdd, robot.rnea(q, qd, qdd))
     assert empty == estimate_payload(robot, q, qd, qdd, robot.rnea(q, qd, qdd))
     assert empty != estimate_payload(robot, q, qd, qdd, tau)
+
+
+# --- from the change of identified coefficients (the paper's static readings) ------------------
+
+
+def identified_pair(payload, noise: float, structure=None, truth=None, **options):
+    """identify_from_controller on 1000 controller readings without and with the payload."""
+    structure = structure or dynid.models.kuka_lwr4()
+    truth = truth or controller_model()
+    fits = []
+    for k, robot in enumerate((truth, truth.with_payload(*payload))):
+        controller = VirtualController(robot, seed=k, model_noise=1e-5 * noise,
+                                       position_noise=1e-5 * noise)
+        data = controller.read_static(controller.random_configurations(1000))
+        fits.append(dynid.identify_from_controller(structure, data.q, data.g, data.M, **options))
+    return fits
+
+
+@pytest.mark.parametrize("name", ["offset_body", "demo_tip"])
+def test_coefficient_changes_give_the_full_payload_and_contain_eqs_31_32(name):
+    # Noise-free controller readings: the gravity and inertia coefficient changes determine all
+    # 10 payload parameters of the LWR (rank 10), exactly (1e-9); the mass equals the paper's
+    # eqs. (31)-(32) estimates (1e-9), which are rows of the same system.
+    mass, com, inertia = PAYLOADS[name]
+    unloaded, loaded = identified_pair(PAYLOADS[name], 0.0)
+    est = dynid.payload_from_identified(unloaded, loaded)
+    assert est.fit is None and est.frame == "flange"
+    assert est.mass == pytest.approx(mass, abs=EXACT)
+    np.testing.assert_allclose(est.com, com, rtol=0, atol=EXACT)
+    np.testing.assert_allclose(est.inertia, inertia, rtol=0, atol=EXACT)
+    paper = dynid.payload_mass_estimates(unloaded.gravity_base, unloaded.pi_g, loaded.pi_g)
+    assert len(paper) == 2
+    for e in paper:
+        assert e["mass"] == pytest.approx(est.mass, abs=EXACT)
+
+
+def test_coefficient_changes_with_the_demo_noise_lie_within_three_std():
+    # Demo noise (model 1e-5 relative, position 1e-5 rad): every quantity within 3 std (std from
+    # both fits' covariances), and the mass within 0.01 % like eqs. (31)-(32).
+    mass, com, inertia = PAYLOADS["offset_body"]
+    unloaded, loaded = identified_pair(PAYLOADS["offset_body"], 1.0)
+    est = dynid.payload_from_identified(unloaded, loaded)
+    assert abs(est.mass - mass) < 3 * est.mass_std
+    assert np.all(np.abs(est.com - com) < 3 * est.com_std)
+    assert np.all(np.abs(est.inertia - inertia) < 3 * est.inertia_std)
+    assert est.mass == pytest.approx(mass, rel=1e-4)
+    for e in dynid.payload_mass_estimates(unloaded.gravity_base, unloaded.pi_g, loaded.pi_g):
+        assert e["mass"] == pytest.approx(mass, rel=1e-4)
+
+
+def test_coefficient_changes_of_a_planar_arm_name_what_they_miss():
+    # The planar 2R's controller readings see m, mx, my and Izz of the payload only.
+    robot = dynid.models.planar_2r()
+    payload = (0.5, np.array([0.1, 0.02, 0.0]), np.diag([1e-3, 2e-3, 2e-3]))
+    fits = identified_pair(payload, 0.0, structure=robot, truth=robot, exclude_gravity_joints=())
+    with pytest.raises(dynid.RankDeficientError,
+                       match=r"^the coefficient changes do not determine the payload: rank 4 < 10"
+                             r"; not determined: mz_L, Ixx_L, Ixy_L, Ixz_L, Iyy_L, Iyz_L$"):
+        dynid.payload_from_identified(*fits)
+
+
+def test_payload_from_identified_bad_arguments():
+    unloaded, loaded = identified_pair(PAYLOADS["demo_tip"], 0.0)
+    with pytest.raises(ValueError, match=r"^loaded: expected a dynid.IdentifiedModel"):
+        dynid.payload_from_identified(unloaded, loaded.pi_g)
+    with pytest.raises(ValueError, match=r"^frame: expected one of"):
+        dynid.payload_from_identified(unloaded, loaded, frame="base")
+    robot = dynid.models.planar_2r()
+    other = identified_pair(PAYLOADS["demo_tip"], 0.0, structure=robot, truth=robot,
+                            exclude_gravity_joints=())[1]
+    with pytest.raises(ValueError, match=r"^loaded: identified on another structure"):
+        dynid.payload_from_identified(unloaded, other)

@@ -43,7 +43,7 @@ if TYPE_CHECKING:
     from .io.preparation import prepare_log
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
-    from .payload import PayloadEstimate, estimate_payload
+    from .payload import PayloadEstimate, estimate_payload, payload_from_identified
     from .recursive import RecursiveLeastSquares
     from .sim import VirtualController
     from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
@@ -83,6 +83,7 @@ _LAZY = {
     "dynamic_bounds": ".bounds",
     "PayloadEstimate": ".payload",
     "estimate_payload": ".payload",
+    "payload_from_identified": ".payload",
     "scale_time": ".time_scaling",
     "scale_motion": ".time_scaling",
     "scale_torques": ".time_scaling",

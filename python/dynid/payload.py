@@ -30,11 +30,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
 from ._checks import real_array
 from ._equality import ValueEquality
+from .from_controller import IdentifiedModel
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .robot import PARAMETER_FIELDS, Robot
 
@@ -60,8 +62,10 @@ class PayloadEstimate(ValueEquality):
     the centre of mass of a zero mass is undefined; ``inertia`` is also None with
     ``inertia=False``.
 
-    The standard deviations reflect the noise of the loaded arm's torques (the least-squares
-    residuals); an error of the unloaded model used for ``tau_unloaded`` is not in them.
+    From :func:`estimate_payload` the standard deviations reflect the noise of the loaded arm's
+    torques (the least-squares residuals); an error of the unloaded model used for
+    ``tau_unloaded`` is not in them. From :func:`payload_from_identified` they come from the
+    covariances of both identifications.
     """
 
     mass: float  #: m_L [kg]
@@ -73,7 +77,9 @@ class PayloadEstimate(ValueEquality):
     parameters: NDArray[np.float64]  #: (10,) or (4,) pi_L = (m, mx, my, mz[, Ixx..Izz about O_n])
     parameters_std: NDArray[np.float64]
     frame: str  #: "flange" or "tool"
-    fit: LeastSquaresResult  #: the least-squares fit of pi_L (residuals, condition number, ...)
+    #: the least-squares fit of pi_L (residuals, condition number, ...); None from
+    #: :func:`payload_from_identified`, which solves for pi_L from coefficient changes
+    fit: LeastSquaresResult | None
 
 
 def estimate_payload(
@@ -163,7 +169,75 @@ def estimate_payload(
         hint = (" Static data (qd = qdd = 0) do not excite the inertia: pass inertia=False."
                 if static and inertia else "")
         raise RankDeficientError(f"the data do not determine the payload: {exc}{hint}") from None
-    return _physical(fit, robot, frame)
+    return _physical(fit.theta, fit.covariance, robot, frame, fit)
+
+
+def payload_from_identified(
+    unloaded: IdentifiedModel, loaded: IdentifiedModel, *, frame: str = "flange"
+) -> PayloadEstimate:
+    """The payload from the change of the paper's identified coefficients (Gaz & De Luca 2017).
+
+    ``unloaded`` and ``loaded`` are :func:`dynid.identify_from_controller` results for the arm
+    without and with the payload (the controller's numeric g(q) and M(q), paper Sect. V). A
+    payload changes the standard parameters of link n only, pi_n -> pi_n + pi_L (notes p. 33), so
+    each base coefficient changes by its expression's link-n part (``base.beta``'s last-link
+    columns B_n, gravity and inertia coefficients stacked):
+
+        [pi_g^L - pi_g; pi_m^L - pi_m] = [B_g,n; B_m,n] pi_L.
+
+    The gravity coefficients see m_L and m_L c_L, the inertia coefficients the inertia as well,
+    so (for the LWR) all 10 payload parameters follow from static readings. Solved by least
+    squares with each change weighted by its standard deviation (floored at 1e-6 of the largest,
+    unweighted when all are zero: noise-free fits); the covariance of pi_L is propagated exactly
+    (linear map) from the sum of the two fits' covariances. Paper eqs. (31)-(32)
+    (:func:`dynid.payload_mass_estimates`) are the rows of this system holding m_n alone.
+    """
+    for name, model in (("unloaded", unloaded), ("loaded", loaded)):
+        if not isinstance(model, IdentifiedModel):
+            raise ValueError(  # noqa: TRY004 -- SPEC 2
+                f"{name}: expected a dynid.IdentifiedModel (identify_from_controller), got "
+                f"{type(model).__name__}"
+            )
+    if not isinstance(frame, str) or frame not in FRAMES:
+        raise ValueError(f"frame: expected one of {FRAMES}, got {frame!r}")
+    robot = unloaded.structure
+    same = all(np.array_equal(getattr(a, field), getattr(b, field))
+               for a, b in ((unloaded.gravity_base, loaded.gravity_base),
+                            (unloaded.inertia_base, loaded.inertia_base))
+               for field in ("independent", "beta"))
+    if not same or not np.array_equal(robot.dh, loaded.structure.dh):
+        raise ValueError("loaded: identified on another structure than unloaded (different DH "
+                         "table or base coefficients): the coefficients cannot be compared")
+    last = slice(10 * (robot.n - 1), 10 * robot.n)
+    B = np.vstack([unloaded.gravity_base.beta[:, last], unloaded.inertia_base.beta[:, last]])
+    change = np.concatenate([loaded.pi_g - unloaded.pi_g, loaded.pi_m - unloaded.pi_m])
+    covariance = scipy.linalg.block_diag(
+        unloaded.gravity_fit.covariance + loaded.gravity_fit.covariance,
+        unloaded.inertia_fit.covariance + loaded.inertia_fit.covariance,
+    )
+    std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    std = np.where(np.isfinite(std), std, 0.0)  # unknown: unweighted
+    weight = 1.0 / np.maximum(std, 1e-6 * std.max()) if std.max() > 0 else np.ones_like(std)
+    weighted = B * weight[:, None]
+    scale = np.linalg.norm(weighted, axis=0)
+    scale[scale == 0] = 1.0
+    # Full V: with fewer coefficients than 10 the null space has more directions than rows.
+    U, sv, Vt = np.linalg.svd(weighted / scale, full_matrices=True)
+    rank = int(np.count_nonzero(sv > 1e-10 * sv[0])) if sv[0] > 0 else 0
+    if rank < B.shape[1]:
+        unseen = np.abs(Vt[rank:]).max(axis=0) > 1e-8
+        raise RankDeficientError(
+            "the coefficient changes do not determine the payload: rank "
+            f"{rank} < {B.shape[1]}; not determined: "
+            f"{', '.join(n for n, u in zip(PAYLOAD_NAMES, unseen) if u)}"
+        )
+    solve = (Vt.T / sv / scale[:, None]) @ U[:, :rank].T * weight  # pi_L = solve @ change
+    theta = solve @ change
+    if np.all(np.isfinite(covariance)):
+        propagated = solve @ covariance @ solve.T
+    else:  # a fit without degrees of freedom for its noise: unknown uncertainty
+        propagated = np.full((theta.size, theta.size), np.inf)
+    return _physical(theta, propagated, robot, frame, None)
 
 
 def physical_from_parameters(theta: NDArray[np.float64]) -> tuple[
@@ -196,12 +270,18 @@ def physical_from_parameters(theta: NDArray[np.float64]) -> tuple[
     return np.concatenate([phi, theta[4:] - S6 / m]), G
 
 
-def _physical(fit: LeastSquaresResult, robot: Robot, frame: str) -> PayloadEstimate:
-    theta, covariance = fit.theta, fit.covariance
-    mass, mass_std = float(theta[0]), float(fit.std[0])
+def _physical(
+    theta: NDArray[np.float64],
+    covariance: NDArray[np.float64],
+    robot: Robot,
+    frame: str,
+    fit: LeastSquaresResult | None,
+) -> PayloadEstimate:
+    parameters_std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    mass, mass_std = float(theta[0]), float(parameters_std[0])
     total = float(np.abs(robot.params[:, 0]).sum()) or 1.0
     common = {"mass": mass, "mass_std": mass_std, "parameters": theta.copy(),
-              "parameters_std": fit.std.copy(), "frame": frame, "fit": fit}
+              "parameters_std": parameters_std, "frame": frame, "fit": fit}
     if not mass > max(SIGNIFICANCE * mass_std, MASS_FLOOR * total):
         return PayloadEstimate(com=None, com_std=None, inertia=None, inertia_std=None, **common)
     phi, G = physical_from_parameters(theta)
