@@ -52,7 +52,9 @@ def test_the_quoted_numbers_are_what_the_examples_print():
         assert text in bounds, bounds
     payload = run(blocks("Payload estimation")[0])
     assert "m = 0.7995 +- 0.0004 kg" in payload
-    static = run(blocks("Payload estimation")[1]).splitlines()
-    masses = [float(x) for x in re.findall(r"[\d.]+", static[0])]
-    assert len(masses) == 2 and all(abs(m - 0.25) < 0.0025 for m in masses)
-    assert static[1].startswith("0.25")
+    paper = run(blocks("Payload estimation")[1]).splitlines()
+    assert paper[0] == "eqs. (31), (32): [0.25001, 0.25]"
+    assert paper[1].startswith("m = 0.25000 +- 5.5e-07 kg, c = [0.")
+    assert paper[1].endswith("0.11] m")
+    assert paper[2] == "I_C diagonal = [1.5e-04 1.5e-04 2.0e-05] kg m^2, std <= 1e-08"
+    assert paper[3].startswith("m = 0.25000 kg at [0.")

@@ -22,6 +22,12 @@ From static data (qd = qdd = 0, e.g. the gravity vectors a controller returns) t
 not enter the torques: only m_L and m_L c_L are identifiable (``inertia=False``). That is the
 setting of paper eqs. (31)-(32) (:func:`dynid.payload_mass_estimates`), which read the mass alone
 off the two gravity coefficients where m_n appears with no other parameter of link n.
+
+The same rule of change applies to identified base coefficients (Gaz & De Luca's title): every
+coefficient is linear in the standard parameters (``base.beta``), so a payload changes it by its
+link-n part. :func:`payload_from_identified` solves the changes of the paper's gravity and
+inertia coefficients (static controller readings, :func:`dynid.identify_from_controller`) for all
+10 payload parameters; eqs. (31)-(32) are its rows that hold m_n alone.
 """
 
 from __future__ import annotations
@@ -53,7 +59,8 @@ _ROWS, _COLS = np.array([0, 0, 0, 1, 1, 2]), np.array([0, 1, 2, 1, 2, 2])
 
 @dataclass(frozen=True, eq=False)
 class PayloadEstimate(ValueEquality):
-    """A payload's inertial parameters estimated by :func:`estimate_payload`.
+    """A payload's inertial parameters estimated by :func:`estimate_payload` (from torques) or
+    :func:`payload_from_identified` (from identified coefficients).
 
     ``com`` and ``inertia`` are in ``frame`` (the last DH frame n, "flange", or the robot's tool
     frame, "tool"); ``parameters`` are always the standard parameters in frame n. ``com``,
