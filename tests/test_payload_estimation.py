@@ -388,3 +388,22 @@ def test_payload_from_identified_bad_arguments():
                             exclude_gravity_joints=())[1]
     with pytest.raises(ValueError, match=r"^loaded: identified on another structure"):
         dynid.payload_from_identified(unloaded, other)
+
+
+def test_as_dict_is_json_ready():
+    # json.dumps accepts it; values round-trip to the estimate's (exact, floats as given).
+    import json
+
+    robot = dynid.models.kuka_lwr4()
+    q, qd, qdd = random_states(robot, 50, seed=0)
+    est = estimate_payload(robot, q, qd, qdd,
+                           robot.with_payload(*PAYLOADS["offset_body"]).rnea(q, qd, qdd))
+    back = json.loads(json.dumps(est.as_dict()))
+    assert back["mass"] == est.mass and back["frame"] == "flange"
+    np.testing.assert_array_equal(back["com"], est.com)
+    np.testing.assert_array_equal(back["inertia_std"], est.inertia_std)
+    assert list(back["parameters"]) == list(PAYLOAD_NAMES)
+    assert back["parameters"]["Izz_L"] == est.parameters[9]
+    empty = estimate_payload(robot, q, qd, qdd, robot.rnea(q, qd, qdd)).as_dict()
+    assert empty["com"] is None and empty["inertia"] is None
+    json.dumps(empty)

@@ -88,6 +88,21 @@ class PayloadEstimate(ValueEquality):
     #: :func:`payload_from_identified`, which solves for pi_L from coefficient changes
     fit: LeastSquaresResult | None
 
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready values (floats, nested lists, None): mass, com, inertia with their std,
+        the standard parameters and the frame."""
+        def plain(value: NDArray[np.float64] | None) -> list | None:
+            return None if value is None else np.asarray(value).tolist()
+
+        return {
+            "mass": self.mass, "mass_std": self.mass_std,
+            "com": plain(self.com), "com_std": plain(self.com_std),
+            "inertia": plain(self.inertia), "inertia_std": plain(self.inertia_std),
+            "parameters": dict(zip(PAYLOAD_NAMES, self.parameters.tolist())),
+            "parameters_std": dict(zip(PAYLOAD_NAMES, self.parameters_std.tolist())),
+            "frame": self.frame,
+        }
+
 
 def estimate_payload(
     robot: Robot,
