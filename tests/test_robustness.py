@@ -268,3 +268,94 @@ def test_cli_log_errors_are_one_line(tmp_path, capsys) -> None:
     status = dynid.cli.main(["validate", str(result), str(other), "--output", str(tmp_path / "v")])
     err = capsys.readouterr().err.strip()
     assert status == 2 and len(err.splitlines()) == 1 and "model" in err
+
+
+# --------------------------------------------------------------------------- item 12
+
+
+def _foreign_log(folder, scale: float = 1e9) -> tuple[str, str, io.Log]:
+    """The LWR4+ recording written as a ROS-like CSV and NPZ: nanosecond stamps, one column per
+    joint named pos_1..pos_7 and effort_1..effort_7 (written out of order on purpose)."""
+    reference = io.load_log("tests/data/measurements_1.npz")
+    columns = {"stamp": (reference.t - reference.t[0]) * scale}
+    for j in (7, 1, 2, 3, 4, 5, 6):  # pos_7 first: the natural order must put it last
+        columns[f"pos_{j}"] = reference.q[:, j - 1]
+        columns[f"effort_{j}"] = reference.tau[:, j - 1]
+    names = list(columns)
+    csv_path, npz_path = folder / "ros.csv", folder / "ros.npz"
+    np.savetxt(csv_path, np.column_stack([columns[k] for k in names]), delimiter=",",
+               header=",".join(names), comments="", fmt="%.17g")
+    np.savez(npz_path, **columns)
+    return str(csv_path), str(npz_path), reference
+
+
+def test_foreign_log_columns_and_time_unit(tmp_path) -> None:
+    csv_path, npz_path, reference = _foreign_log(tmp_path)
+    mapping = {"t": "stamp", "q": "pos_*", "tau": "effort_*"}
+    for path in (csv_path, npz_path):
+        log = io.load_log(path, columns=mapping, time_unit="ns")
+        assert np.array_equal(log.q, reference.q) and np.array_equal(log.tau, reference.tau)
+        assert np.allclose(log.t, reference.t - reference.t[0], rtol=0, atol=1e-12)
+        assert abs(log.fs - 200.0) < 1.0
+    with pytest.warns(UserWarning, match="sampling rate is 2e-07 Hz.*'ns'"):
+        io.load_log(csv_path, columns=mapping)  # the stamps read as seconds
+    with pytest.raises(ValueError, match="columns: nothing matches 'joint_\\*' for q"):
+        io.load_log(csv_path, columns={"t": "stamp", "q": "joint_*", "tau": "effort_*"})
+    with pytest.raises(ValueError, match="^time_unit: "):
+        io.load_log(csv_path, columns=mapping, time_unit="hours")
+    from dynid.io.columns import parse_columns
+
+    assert parse_columns("t=stamp, q=pos_*,tau=effort_*") == mapping
+    with pytest.raises(ValueError, match="^columns: unknown signal 'x'"):
+        parse_columns("x=pos_*")
+
+
+def test_cli_foreign_log_warns_in_one_line(tmp_path, capsys) -> None:
+    csv_path, _, _ = _foreign_log(tmp_path)
+    status = dynid.cli.main(["identify", csv_path, "--columns", "t=stamp,q=pos_*,tau=effort_*",
+                             "--skip", "4500", "--output", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert status == 0
+    assert "dynid identify: warning: ros.csv: t: the median sampling rate" in err
+    assert "Traceback" not in err and "UserWarning" not in err
+
+
+def test_result_file_carries_covariance_units_and_version(small_result, tmp_path) -> None:
+    path = save_result(small_result, tmp_path / "r", plots=False)
+    data = json.loads(path.read_text())
+    assert data["version"] == 2 and data["dynid_version"] == dynid.__version__
+    assert data["units"]["torque"] == "N m"
+    loaded = load_result(path)
+    assert np.allclose(loaded.covariance, small_result.covariance, rtol=1e-15, atol=0)
+    data["version"] = 99
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="version: expected a format version 1..2"):
+        load_result(path)
+
+
+# --------------------------------------------------------------------------- item 15
+
+
+def test_import_dynid_loads_no_plotting_or_optimisers() -> None:
+    """``import dynid`` stays light (its time is measured in bench/, never here): matplotlib,
+    SciPy's optimisers and signal processing load only when a function needs them."""
+    import subprocess
+    import sys
+
+    heavy = ("matplotlib", "scipy.optimize", "scipy.signal", "scipy.ndimage")
+    code = ("import sys, dynid; dynid.Robot; dynid.models.kuka_lwr4(); "
+            f"print(','.join(m for m in {heavy!r} if m in sys.modules))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            check=True).stdout.strip()
+    assert loaded == ""
+
+
+def test_load_model_reads_builtin_names_and_urdf() -> None:
+    """The CLI's --model: the new built-in names and a URDF path give the models of
+    dynid.models / Robot.from_urdf (exact: the same construction)."""
+    from dynid.io.model_files import load_model
+
+    assert load_model("panda") == dynid.models.panda()
+    assert load_model("ur5") == dynid.models.ur5()
+    urdf = "tests/data/urdf/kuka_lwr4.urdf"
+    assert load_model(urdf) == dynid.Robot.from_urdf(urdf)

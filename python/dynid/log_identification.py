@@ -74,6 +74,8 @@ class LogIdentification(ValueEquality):
     condition_number: float
     rank: int
     excluded: tuple[int, ...] = ()
+    #: (count, count) covariance of ``theta`` (None for results saved before format version 2)
+    covariance: NDArray[np.float64] | None = None
     training: dict[str, Any] = field(default_factory=dict)
     #: the prepared training log (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
@@ -195,6 +197,7 @@ def identify_log(
     fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints)
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
+    result.covariance = fit.covariance
     result.excluded = fit.excluded
     for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
         result.model.pop(key, None)
