@@ -17,6 +17,7 @@ from .identify import LeastSquaresResult, RankDeficientError, least_squares
 from .io import Log, load_log, prepare_log, save_log
 from .log_identification import LogIdentification, identify_log, validate_log
 from .model_files import load_model, save_model
+from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
 from .recursive import RecursiveLeastSquares
 from .result_files import load_result
 from .robot import Robot
@@ -29,6 +30,8 @@ __all__ = [
     "LeastSquaresResult",
     "Log",
     "LogIdentification",
+    "PhysicalIdentificationError",
+    "PhysicalResult",
     "RankDeficientError",
     "RecursiveLeastSquares",
     "Robot",
@@ -46,6 +49,7 @@ __all__ = [
     "models",
     "optimize_excitation",
     "payload_mass_estimates",
+    "physical_least_squares",
     "prepare_log",
     "save_log",
     "save_model",

@@ -5,7 +5,9 @@ the model (DH table, joint types, convention, gravity, base/tool, limits), the r
 the base-parameter structure (independent columns and beta over the standard parameter names),
 the coefficients with their expressions and standard deviations, the condition number and rank,
 and the training log's preparation and per-joint fit. Non-finite numbers (a relative standard
-deviation of a coefficient that is exactly 0) are written as null.
+deviation of a coefficient that is exactly 0) are written as null. A physically consistent
+result (``identify_log(physical=True)``) also holds the identified parameters in ``model`` and
+the solver's report in ``physical``; ``load_result(...).robot`` is then the identified robot.
 """
 
 from __future__ import annotations
@@ -82,7 +84,7 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     ]
     training = dict(result.training)
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
-    return {
+    data = {
         "format": FORMAT,
         "version": VERSION,
         "model": result.model,
@@ -99,6 +101,9 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
             "beta": _nums(result.beta),
         },
     }
+    if result.physical is not None:
+        data["physical"] = result.physical
+    return data
 
 
 def result_from_dict(data: Any) -> LogIdentification:
@@ -150,6 +155,12 @@ def result_from_dict(data: Any) -> LogIdentification:
     training["metrics"] = {k: _array(v, f"training.metrics.{k}", 1, nullable=True)
                            for k, v in metrics.items()}
     method = _get(options, "method", "options")
+    physical = data.get("physical")
+    if physical is not None:
+        physical = _object(physical, "physical")
+        if not robot.is_physically_consistent():
+            raise ValueError("model: a physically consistent result whose parameters are not "
+                             "physically consistent (edited file?)")
     return LogIdentification(
         model=dict(model), rotor=flags["rotor"], friction=flags["friction"],
         offset=flags["offset"], method=str(method), parameter_names=list(names_std),
@@ -164,6 +175,7 @@ def result_from_dict(data: Any) -> LogIdentification:
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
+        physical=physical,
         _robot=robot,
     )
 
