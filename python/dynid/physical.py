@@ -391,6 +391,10 @@ def _data(Y: ArrayLike, tau: ArrayLike, n: int, columns: int
           ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     Y = real_array(Y, "Y")
     tau = real_array(tau, "tau")
+    if Y.ndim in (2, 3) and Y.shape[-1] != columns:
+        raise ValueError(f"Y: expected {columns} columns (the regressor of the model with the "
+                         "rotor/friction options given, plus extra_columns), got "
+                         f"{Y.shape[-1]}")
     if Y.ndim == 2:
         if Y.shape[0] == 0 or Y.shape[0] % n:
             raise ValueError(f"Y: expected (N, {columns}) with N a positive multiple of n = {n} "
@@ -407,10 +411,6 @@ def _data(Y: ArrayLike, tau: ArrayLike, n: int, columns: int
             raise ValueError(f"tau: expected shape {Y.shape[:2]} to match Y, got {tau.shape}")
     else:
         raise ValueError(f"Y: expected (T, n, P) or (N, P), got shape {Y.shape}")
-    if Y.shape[2] != columns:
-        raise ValueError(f"Y: expected {columns} columns (the regressor of the model with the "
-                         "rotor/friction options given, plus extra_columns), got "
-                         f"{Y.shape[2]}")
     return Y, tau
 
 
