@@ -222,6 +222,29 @@ def test_data_of_an_impossible_robot_give_a_consistent_robot_and_a_larger_residu
     assert np.all(fit.Ia >= 0) and np.all(fit.Fv >= 0) and np.all(fit.Fs >= 0)
 
 
+def test_no_feasible_step_improves_the_optimum(lwr, inconsistent):
+    """Optimality checked without the solver: from the estimate x, a step toward any feasible
+    point y (random consistent links, random non-negative drive terms; x + e (y - x) is feasible
+    by convexity) never lowers the sum of squared residuals, for e = 1e-3, 1e-2, 0.1 (to 1e-9
+    relative: the solver's accuracy)."""
+    _, Y, tau = inconsistent
+    fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True)
+
+    def sse(theta):
+        return float(np.sum((tau - Y @ theta) ** 2))
+
+    best = sse(fit.theta)
+    rng = np.random.default_rng(13)
+    for _ in range(30):
+        y = np.empty_like(fit.theta)
+        for i in range(lwr.n):
+            L = rng.normal(0, 0.3, (4, 4))
+            y[10 * i:10 * i + 10] = standard_from_pseudo_inertia(L @ L.T + 1e-3 * np.eye(4))
+        y[10 * lwr.n:] = rng.uniform(0, 2, 3 * lwr.n)
+        for step in (1e-3, 1e-2, 0.1):
+            assert sse(fit.theta + step * (y - fit.theta)) >= best * (1 - 1e-9)
+
+
 def test_mass_bounds_and_total_mass_are_respected(lwr, base, data):
     """Bounds that exclude the true masses of links 3 and 5: the estimate sits in them (to
     1e-7 kg); a total mass equality holds to 1e-7 kg. No link mass of the LWR is a base

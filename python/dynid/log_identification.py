@@ -147,6 +147,13 @@ class LogIdentification:
         fit = (f"{self.count} base parameters{offsets}, {self.method.upper()}, rank "
                f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}")
         head = [model, fit]
+        if self.physical is not None:
+            report = self.physical
+            prior = (f"prior {report.get('prior')} (weight {report.get('prior_weight'):g})"
+                     if report.get("prior") else "no prior")
+            head.append(f"physically consistent fit: SDP, {report.get('solver')} status "
+                        f"{report.get('status')}, {prior}; the values are the base parameters of "
+                        "the identified robot (no standard deviations)")
         width = max(11, *(len(name) for name in self.names))
         title = f"  {'coefficient':<{width}}  {'value':>12}  {'std':>10}  {'rel.std':>8}  expression"
         lines = [title]
