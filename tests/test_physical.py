@@ -20,7 +20,7 @@ import pytest
 from dynid.identify import least_squares
 from dynid.io import Log
 from dynid.log_identification import identify_log
-from dynid.model_files import save_model
+from dynid.io.model_files import save_model
 from dynid.physical import PhysicalIdentificationError, physical_least_squares
 from dynid.pseudo_inertia import nearest_with_margin, pseudo_inertia, standard_from_pseudo_inertia
 

@@ -17,8 +17,9 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
    that robot (``result.robot``, saved with the result) and its base values as ``theta``.
 
 The result predicts torques on any log (``predict``), is checked on another log
-(:func:`validate_log`) and is saved to a folder (JSON with everything needed to apply it again,
-including the model's DH table, plus PNG plots) and loaded back (:func:`load_result`).
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result` (JSON with everything needed
+to apply it again, including the model's DH table, plus PNG plots) and loaded back by
+:func:`dynid.load_result`.
 """
 
 from __future__ import annotations
@@ -31,10 +32,12 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
+from ._equality import ValueEquality
 from .base_parameters import base_parameters
 from .identify import VARIANCE_FLOOR, least_squares
-from .io import Log, prepare_log
-from .model_files import load_model, model_from_dict, model_to_dict
+from .io.log_files import Log
+from .io.model_files import load_model, model_from_dict, model_to_dict
+from .io.preparation import prepare_log
 from .physical import physical_least_squares
 from .robot import Robot
 from .validation import error_metrics, validation_table
@@ -56,7 +59,7 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 
 @dataclass(eq=False)
-class LogIdentification:
+class LogIdentification(ValueEquality):
     """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
@@ -68,11 +71,11 @@ class LogIdentification:
     A physically consistent result (``identify_log(physical=True)``) has ``physical`` set (the
     solver's report: status, solver, times, prior, prior_weight, margin) and ``model`` holds the
     identified standard parameters and drive terms, so ``robot`` is the identified robot;
-    ``theta`` holds its base values (beta @ pi) and the offsets, ``std`` is inf (the constrained
-    estimate has no least-squares covariance).
+    ``theta`` holds its base values (beta @ pi) and the offsets; ``std`` is inf and
+    ``covariance`` None (the constrained estimate has no least-squares covariance).
     """
 
-    model: dict[str, Any]  #: the robot model (``dynid.model_files`` format): DH table etc.
+    model: dict[str, Any]  #: the robot model (``dynid.io.model_files`` format): DH table etc.
     rotor: bool
     friction: bool
     offset: bool
@@ -88,10 +91,13 @@ class LogIdentification:
     condition_number: float
     rank: int
     excluded: tuple[int, ...] = ()
+    #: (count, count) covariance of ``theta`` (None for results saved before format version 2)
+    covariance: NDArray[np.float64] | None = None
     training: dict[str, Any] = field(default_factory=dict)
-    log: Log | None = field(default=None, repr=False)  #: the prepared training log (not saved)
     physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
-    _robot: Robot | None = field(default=None, repr=False)
+    #: the prepared training log (not saved, not compared)
+    log: Log | None = field(default=None, repr=False, compare=False)
+    _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
     def n(self) -> int:
@@ -168,15 +174,6 @@ class LogIdentification:
             text += validation_table(arrays)
         return text
 
-    def save(self, folder: PathLike, log: Log | None = None, plots: bool = True) -> Path:
-        """Write ``result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of the
-        fit on ``log`` (default: the training log, when kept) into ``folder``; returns the JSON
-        path."""
-        from .result_files import save_result
-
-        log = log if log is not None else self.log
-        return save_result(self, folder, log if plots else None)
-
 
 def identify_log(
     log: Log,
@@ -244,6 +241,7 @@ def identify_log(
     fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints)
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
+    result.covariance = fit.covariance
     result.excluded = fit.excluded
     for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
         result.model.pop(key, None)
@@ -273,10 +271,10 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
         Y = np.concatenate([Y, np.broadcast_to(np.eye(n), (Y.shape[0], n, n))], axis=2)
     weights = np.ones(n)
     kept = [j for j in range(n) if j not in result.excluded]
-    if result.method == "wls":  # as dynid.least_squares: 1 / sigma_j, variances floored
-        variance = noise_variance
-        floored = np.maximum(variance, VARIANCE_FLOOR * variance.max())
-        weights[kept] = 1.0 / np.sqrt(floored) if variance.max() > 0 else 1.0
+    usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
+    if result.method == "wls" and usable:  # as dynid.least_squares: 1 / sigma_j
+        floored = np.maximum(noise_variance, VARIANCE_FLOOR * noise_variance.max())
+        weights[kept] = 1.0 / np.sqrt(floored)
     weights[list(result.excluded)] = 0.0
     fit = physical_least_squares(robot, Y, log.tau, rotor=result.rotor, friction=result.friction,
                                  weights=weights, prior=prior, prior_weight=prior_weight,
@@ -284,6 +282,7 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
     result.theta = np.concatenate([fit.base_values, fit.extra])
     result.std = np.full(result.theta.size, np.inf)
     result.relative_std = np.full(result.theta.size, np.inf)
+    result.covariance = None
     result.model = model_to_dict(fit.robot)
     result._robot = fit.robot
     result.physical = {
@@ -299,18 +298,48 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
 
 
 def _prior_model(prior: Any) -> Robot:
-    """The prior: a Robot, or a model file / built-in name read by dynid.load_model."""
+    """The prior: a Robot, or a model file / built-in name read by dynid.load_model (a URDF
+    path by Robot.from_urdf when it exists)."""
     if isinstance(prior, Robot):
         return prior
     if not isinstance(prior, (str, Path)):
         raise ValueError(f"prior: expected a dynid.Robot or the path of a model file, got "
                          f"{type(prior).__name__}")
-    path = Path(prior)
-    if path.suffix.lower() == ".urdf":
+    if Path(prior).suffix.lower() == ".urdf":
         if not hasattr(Robot, "from_urdf"):
-            raise ValueError(f"prior: {path}: URDF priors need dynid.Robot.from_urdf")
-        return Robot.from_urdf(path)
+            raise ValueError(f"prior: {prior}: reading a URDF needs dynid.Robot.from_urdf")
+        return Robot.from_urdf(prior)
     return load_model(prior)
+
+
+@dataclass(eq=False)
+class LogValidation(ValueEquality):
+    """An identified model applied to another log: the prepared log, the predicted torques and
+    the per-joint errors (:func:`dynid.validation.error_metrics`)."""
+
+    log: Log  #: the validation log after ``preparation``
+    predicted: NDArray[np.float64]
+    metrics: dict[str, NDArray[np.float64]]
+    preparation: dict[str, Any]
+    notes: list[str] = field(default_factory=list)  #: differences from the training preparation
+
+
+def run_validation(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> LogValidation:
+    """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
+    and measure the errors; ``notes`` says where the preparation differs from the training
+    log's (a low-pass on one and not the other biases the comparison)."""
+    options = _options(preparation)
+    prepared = prepare_log(log, **options) if options else log
+    predicted = result.predict(prepared)
+    notes = []
+    trained = result.training.get("preparation", {}).get("cutoff")
+    if trained != options.get("cutoff"):
+        notes.append(f"the training log was {_filtered(trained)}, this one is "
+                     f"{_filtered(options.get('cutoff'))}")
+    return LogValidation(prepared, predicted, error_metrics(prepared.tau, predicted), options,
+                         notes)
 
 
 def validate_log(
@@ -319,16 +348,11 @@ def validate_log(
     """Per-joint errors of ``result`` on another log (``prepare_log(log, **preparation)``
     first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
     ``r2`` and ``mse`` (see :func:`dynid.validation.error_metrics`)."""
-    options = _options(preparation)
-    prepared = prepare_log(log, **options) if options else log
-    return error_metrics(prepared.tau, result.predict(prepared))
+    return run_validation(result, log, preparation=preparation).metrics
 
 
-def load_result(path: PathLike) -> LogIdentification:
-    """A result saved by :meth:`LogIdentification.save`: its folder or its ``result.json``."""
-    from .result_files import load_result as _load
-
-    return _load(path)
+def _filtered(cutoff: float | None) -> str:
+    return "not low-passed" if cutoff is None else f"low-passed at {cutoff:g} Hz"
 
 
 def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:

@@ -19,31 +19,77 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from .io import Log
-from .log_identification import LogIdentification
+from .._version import dynid_version
+from ..log_identification import LogIdentification, LogValidation
+from .log_files import Log
 from .model_files import dumps_json, model_from_dict
-from .plots import plot_residuals, plot_torques
+from .output_folder import output_folder
 
 PathLike = Union[str, Path]
 
 FORMAT = "dynid-identification"
-VERSION = 1
+#: Format version written; the loader reads versions 1 (no covariance) to VERSION.
+VERSION = 2
+#: Units of what a result holds (written into result.json for readers other than dynid).
+UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "torque": "N m",
+         "coefficients": "SI, as their expressions over the standard parameters"}
 RESULT_FILE = "result.json"
+VALIDATION_FORMAT = "dynid-validation"
+VALIDATION_FILE = "validation.json"
 
 
-def save_result(result: LogIdentification, folder: PathLike, log: Log | None = None) -> Path:
-    """Write ``folder/result.json`` and, when ``log`` is given, the plots of the fit on it."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / RESULT_FILE
-    path.write_text(dumps_json(result_to_dict(result)) + "\n")
-    if log is not None:
-        save_plots(folder, log, result.predict(log), "training log")
-    return path
+def save_result(
+    result: LogIdentification,
+    folder: PathLike,
+    log: Log | None = None,
+    plots: bool = True,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``folder/result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of
+    the fit on ``log`` (default: the training log, when the result kept it); returns the JSON
+    path. ``folder`` must be new or empty unless ``overwrite``; it is written as a whole or not
+    at all (:mod:`dynid.io.output_folder`)."""
+    log = log if log is not None else result.log
+    with output_folder(folder, overwrite) as staging:
+        (staging / RESULT_FILE).write_text(dumps_json(result_to_dict(result)) + "\n")
+        if plots and log is not None:
+            save_plots(staging, log, result.predict(log), "training log")
+    return Path(folder) / RESULT_FILE
+
+
+def save_validation(
+    validation: LogValidation,
+    folder: PathLike,
+    *,
+    result_source: str = "",
+    log_source: str = "",
+    plots: bool = True,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``folder/validation.json`` (per-joint metrics, preparation, sources) and, when
+    ``plots``, the torque and residual plots of the validation log; returns the JSON path."""
+    report = {
+        "format": VALIDATION_FORMAT,
+        "version": VERSION,
+        "dynid_version": dynid_version(),
+        "result": result_source,
+        "log": log_source,
+        "samples": validation.log.T,
+        "preparation": validation.preparation,
+        "notes": validation.log.notes,
+        "metrics": metrics_to_dict(validation.metrics),
+    }
+    with output_folder(folder, overwrite) as staging:
+        (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
+        if plots:
+            save_plots(staging, validation.log, validation.predicted, "validation log")
+    return Path(folder) / VALIDATION_FILE
 
 
 def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str) -> list[Path]:
     """``torques.png`` (measured and predicted torque per joint) and ``residuals.png``."""
+    from ..plots import plot_residuals, plot_torques  # matplotlib: imported when plotting
+
     t = log.t - log.t[0]
     name = Path(log.source).name or what
     return [
@@ -87,6 +133,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     data = {
         "format": FORMAT,
         "version": VERSION,
+        "dynid_version": dynid_version(),
+        "units": UNITS,
         "model": result.model,
         "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
                     "method": result.method, "exclude_joints": list(result.excluded)},
@@ -94,6 +142,7 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         "rank": result.rank,
         "coefficients": coefficients,
         "training": training,
+        "covariance": _nums(result.covariance) if result.covariance is not None else None,
         "base_parameters": {
             "count": result.count,
             "parameter_names": result.parameter_names,
@@ -112,6 +161,11 @@ def result_from_dict(data: Any) -> LogIdentification:
     if data.get("format") != FORMAT:
         raise ValueError(f"format: expected {FORMAT!r} (a dynid identify result), got "
                          f"{data.get('format')!r}")
+    version = data.get("version")
+    if not (isinstance(version, int) and not isinstance(version, bool) and 1 <= version <= VERSION):
+        raise ValueError(f"version: expected a format version 1..{VERSION} (written by dynid "
+                         f"{data.get('dynid_version', '?')}; this is dynid {dynid_version()}), "
+                         f"got {version!r}")
     model = _object(_get(data, "model"), "model")
     try:
         robot = model_from_dict(model)
@@ -175,9 +229,19 @@ def result_from_dict(data: Any) -> LogIdentification:
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
+        covariance=_covariance(data.get("covariance"), count + (robot.n if flags["offset"] else 0)),
         physical=physical,
         _robot=robot,
     )
+
+
+def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
+    if value is None:
+        return None
+    covariance = _array(value, "covariance", 2, nullable=True)
+    if covariance.shape != (size, size):
+        raise ValueError(f"covariance: expected shape ({size}, {size}), got {covariance.shape}")
+    return covariance
 
 
 def metrics_to_dict(metrics: dict[str, NDArray[np.float64]]) -> dict[str, list]:
