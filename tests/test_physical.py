@@ -439,8 +439,8 @@ def test_identify_log_physical_saves_and_loads_the_robot(lwr, log, tmp_path):
     np.testing.assert_allclose(predicted, log.tau, rtol=0, atol=1e-6 * np.abs(log.tau).max())
     np.testing.assert_allclose(result.robot.rnea(log.q, log.qd, log.qdd) + offsets, predicted,
                                rtol=0, atol=1e-6 * np.abs(log.tau).max())
-    result.save(tmp_path, plots=False)
-    loaded = dynid.load_result(tmp_path)
+    dynid.save_result(result, tmp_path / "result", plots=False)
+    loaded = dynid.load_result(tmp_path / "result")
     np.testing.assert_array_equal(loaded.robot.params, result.robot.params)
     for key in ("Ia", "Fv", "Fs"):
         np.testing.assert_array_equal(getattr(loaded.robot, key), getattr(result.robot, key))

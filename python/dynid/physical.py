@@ -43,8 +43,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._checks import positive, real_array
+from ._checks import positive
+from ._equality import ValueEquality
 from .base_parameters import base_parameters
+from .physical_arguments import (check_count, check_data, check_flag, check_mass_bounds,
+                                 check_prior, check_prior_weight, check_total_mass, check_weights)
 from .pseudo_inertia import nearest_with_margin, pseudo_inertia, standard_from_pseudo_inertia
 from .robot import Robot
 
@@ -81,8 +84,9 @@ class PhysicalIdentificationError(RuntimeError):
 
 
 @dataclass(eq=False)
-class PhysicalResult:
-    """A physically consistent estimate (see :func:`physical_least_squares`)."""
+class PhysicalResult(ValueEquality):
+    """A physically consistent estimate (see :func:`physical_least_squares`); pickles, copies
+    and compares by value."""
 
     robot: Robot  #: copy of the model with the identified parameters (consistent, M(q) > 0)
     params: NDArray[np.float64]  #: (n, 10) standard parameters
@@ -104,25 +108,6 @@ class PhysicalResult:
     projected: tuple[int, ...] = ()  #: links (0-based) moved onto the margin after the solve
     projection: float = 0.0  #: largest relative change made by that projection
     options: dict[str, Any] = field(default_factory=dict)
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, PhysicalResult):
-            return NotImplemented
-        mine, theirs = self.__getstate__(), other.__getstate__()
-        return mine.keys() == theirs.keys() and all(_same(mine[k], theirs[k]) for k in mine)
-
-    __hash__ = None  # type: ignore[assignment]  # mutable, compared by value
-
-    def __getstate__(self) -> dict[str, Any]:
-        # The C++-backed Robot does not pickle itself: it travels as the arguments of from_dh.
-        state = dict(self.__dict__)
-        state["robot"] = robot_state(self.robot)
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        state = dict(state)
-        state["robot"] = robot_from_state(state["robot"])
-        self.__dict__.update(state)
 
 
 def physical_least_squares(
@@ -187,17 +172,17 @@ def physical_least_squares(
     if not isinstance(robot, Robot):
         raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
             f"robot: expected a dynid.Robot, got {type(robot).__name__}")
-    rotor, friction = _flag(rotor, "rotor"), _flag(friction, "friction")
+    rotor, friction = check_flag(rotor, "rotor"), check_flag(friction, "friction")
     n = robot.n
     P = robot.parameter_vector(rotor, friction).size
-    k = _count(extra_columns, "extra_columns")
-    Y3, tau2 = _data(Y, tau, n, P + k)
-    w = _weights(weights, Y3.shape[0], n)
+    k = check_count(extra_columns, "extra_columns")
+    Y3, tau2 = check_data(Y, tau, n, P + k)
+    w = check_weights(weights, Y3.shape[0], n)
     margin = positive(margin, "margin")
-    prior_weight = _prior_weight(prior_weight, prior)
-    prior_x = _prior(prior, robot, rotor, friction) if prior is not None else None
-    lower, upper = _mass_bounds(mass_bounds, n)
-    total = _total_mass(total_mass)
+    prior_weight = check_prior_weight(prior_weight, prior)
+    prior_x = check_prior(prior, robot, rotor, friction) if prior is not None else None
+    lower, upper = check_mass_bounds(mass_bounds, n)
+    total = check_total_mass(total_mass)
 
     # Scaled, compressed residual: rows weighted, columns to unit norm, torques to unit norm,
     # then A_s = Q R so that ||A_s z - b_s||^2 = ||R z - Q^T b_s||^2 + r0^2 (r0 constant).
@@ -286,23 +271,6 @@ def physical_least_squares(
     )
 
 
-def robot_state(robot: Robot) -> dict[str, Any]:
-    """Everything that defines ``robot``, as plain values (for pickling and comparison)."""
-    return {"dh": robot.dh, "joint_types": robot.joint_types, "convention": robot.convention,
-            "gravity": robot.gravity_vector, "params": robot.params, "base": robot.base,
-            "tool": robot.tool, "qlim": robot.qlim, "name": robot.name, "Ia": robot.Ia,
-            "Fv": robot.Fv, "Fs": robot.Fs}
-
-
-def robot_from_state(state: dict[str, Any]) -> Robot:
-    """The inverse of :func:`robot_state`."""
-    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"], state["gravity"],
-                          state["params"], state["base"], state["tool"], state["qlim"],
-                          state["name"])
-    robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
-    return robot
-
-
 # --------------------------------------------------------------------------- the problem
 
 
@@ -382,150 +350,3 @@ def _column_norms(A: NDArray[np.float64]) -> NDArray[np.float64]:
     norms = peak * np.linalg.norm(A / peak, axis=0)
     norms[norms == 0] = 1.0  # a column that is zero everywhere keeps the unit scale
     return norms
-
-
-# --------------------------------------------------------------------------- argument checks
-
-
-def _data(Y: ArrayLike, tau: ArrayLike, n: int, columns: int
-          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    Y = real_array(Y, "Y")
-    tau = real_array(tau, "tau")
-    if Y.ndim in (2, 3) and Y.shape[-1] != columns:
-        raise ValueError(f"Y: expected {columns} columns (the regressor of the model with the "
-                         "rotor/friction options given, plus extra_columns), got "
-                         f"{Y.shape[-1]}")
-    if Y.ndim == 2:
-        if Y.shape[0] == 0 or Y.shape[0] % n:
-            raise ValueError(f"Y: expected (N, {columns}) with N a positive multiple of n = {n} "
-                             f"(rows sample after sample), got shape {Y.shape}")
-        Y = Y.reshape(-1, n, Y.shape[1])
-        if tau.shape != (Y.shape[0] * n,):
-            raise ValueError(f"tau: expected shape ({Y.shape[0] * n},) to match Y, got "
-                             f"{tau.shape}")
-        tau = tau.reshape(-1, n)
-    elif Y.ndim == 3:
-        if Y.shape[0] == 0 or Y.shape[1] != n:
-            raise ValueError(f"Y: expected (T, {n}, {columns}) with T >= 1, got shape {Y.shape}")
-        if tau.shape != Y.shape[:2]:
-            raise ValueError(f"tau: expected shape {Y.shape[:2]} to match Y, got {tau.shape}")
-    else:
-        raise ValueError(f"Y: expected (T, n, P) or (N, P), got shape {Y.shape}")
-    return Y, tau
-
-
-def _weights(weights: ArrayLike | None, T: int, n: int) -> NDArray[np.float64]:
-    if weights is None:
-        return np.ones((T, n))
-    w = real_array(weights, "weights")
-    if w.shape == (n,):
-        w = np.broadcast_to(w, (T, n))
-    elif w.shape == (T * n,):
-        w = w.reshape(T, n)
-    elif w.shape != (T, n):
-        raise ValueError(f"weights: expected one per joint ({n},) or one per row ({T}, {n}) / "
-                         f"({T * n},), got shape {w.shape}")
-    if np.any(w < 0) or not np.any(w > 0):
-        raise ValueError("weights: expected non-negative values, at least one positive")
-    return np.array(w, dtype=float)
-
-
-def _prior(prior: Any, robot: Robot, rotor: bool, friction: bool) -> NDArray[np.float64]:
-    if not isinstance(prior, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
-            f"prior: expected a dynid.Robot, got {type(prior).__name__}")
-    if (prior.n, prior.joint_types, prior.convention) != (robot.n, robot.joint_types,
-                                                          robot.convention):
-        raise ValueError(
-            f"prior: expected a model with the robot's DH frames ({robot.n} joints "
-            f"{robot.joint_types!r}, {robot.convention} DH), got {prior.n} joints "
-            f"{prior.joint_types!r}, {prior.convention} DH")
-    # Same DH frames: the same regressor at random states (a prior whose frame 0 differs by a
-    # translation along gravity, e.g. d1 of a base-to-shoulder height, passes: its link frames
-    # are the robot's, so its standard parameters mean the same).
-    rng = np.random.default_rng(0)
-    q = robot.random_configurations(4, seed=0)
-    qd, qdd = rng.uniform(-1, 1, (2, 4, robot.n))
-    mine, theirs = robot.regressor(q, qd, qdd), prior.regressor(q, qd, qdd)
-    if not np.allclose(mine, theirs, rtol=1e-9, atol=1e-9 * np.abs(mine).max()):
-        raise ValueError("prior: its standard parameters are not expressed in the robot's DH "
-                         "frames (the two models' regressors differ); map the prior to the "
-                         "robot's DH table first")
-    bad = [f"link {i + 1}: {why}" for i in range(prior.n) if (why := prior._link_inconsistency(i))]
-    if bad:
-        raise ValueError("prior: expected a physically consistent model, " + "; ".join(bad))
-    values = prior.parameter_vector(rotor, friction)
-    if np.any(values[10 * prior.n:] < 0):
-        raise ValueError("prior: its Ia, Fv, Fs must be >= 0 (the estimate's are)")
-    return values
-
-
-def _prior_weight(value: Any, prior: Any) -> float:
-    if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"prior_weight: expected a number >= 0, got {value!r}")
-    try:
-        weight = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"prior_weight: expected a number >= 0, got {value!r}") from None
-    if not np.isfinite(weight) or weight < 0:
-        raise ValueError(f"prior_weight: expected a finite number >= 0, got {value!r}")
-    if weight > 0 and prior is None:
-        raise ValueError(f"prior_weight: {weight} > 0 needs a prior model (prior is None)")
-    if weight == 0 and prior is not None:
-        raise ValueError("prior_weight: a prior is given but prior_weight is 0, so it would be "
-                         "ignored; give prior_weight > 0")
-    return weight
-
-
-def _mass_bounds(value: ArrayLike | None, n: int
-                 ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
-    if value is None:
-        return None, None
-    bounds = real_array(value, "mass_bounds", finite=False)
-    if bounds.shape != (n, 2):
-        raise ValueError(f"mass_bounds: expected shape ({n}, 2) [lower, upper] per link, got "
-                         f"{bounds.shape}")
-    lower, upper = bounds[:, 0], bounds[:, 1]
-    if np.any(np.isnan(bounds)) or not np.all(np.isfinite(lower)) or np.any(upper == -np.inf):
-        raise ValueError("mass_bounds: expected finite lower bounds and upper bounds that are "
-                         "finite or inf, got NaN or -inf or an infinite lower bound")
-    if np.any(lower < 0) or np.any(upper < lower):
-        raise ValueError(f"mass_bounds: expected 0 <= lower <= upper per link, got {bounds.tolist()}")
-    return lower.copy(), upper.copy()
-
-
-def _total_mass(value: Any) -> tuple[float, float] | None:
-    if value is None:
-        return None
-    bounds = real_array(value, "total_mass")
-    if bounds.shape == ():
-        bounds = np.array([bounds, bounds])
-    if bounds.shape != (2,) or bounds[0] > bounds[1] or bounds[1] <= 0 or bounds[0] < 0:
-        raise ValueError(f"total_mass: expected a mass > 0 in kg or (lower, upper) with "
-                         f"0 <= lower <= upper, upper > 0, got {value!r}")
-    return float(bounds[0]), float(bounds[1])
-
-
-def _flag(value: Any, name: str) -> bool:
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    raise ValueError(f"{name}: expected True or False, got {value!r}")
-
-
-def _count(value: Any, name: str) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"{name}: expected an integer >= 0, got {value!r}")
-    return int(value)
-
-
-def _same(a: Any, b: Any) -> bool:
-    """Equality of two state values (arrays, dicts, numbers, strings, None) that never raises."""
-    if isinstance(a, dict) or isinstance(b, dict):
-        return (isinstance(a, dict) and isinstance(b, dict) and a.keys() == b.keys()
-                and all(_same(a[k], b[k]) for k in a))
-    if a is None or b is None:
-        return a is b
-    x, y = np.asarray(a), np.asarray(b)
-    if x.dtype.kind in "iuf" and y.dtype.kind in "iuf":
-        return bool(np.array_equal(x, y, equal_nan=True))
-    return x.shape == y.shape and bool(np.all(x == y))
