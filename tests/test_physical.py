@@ -467,3 +467,23 @@ def test_identify_log_checks_the_physical_options(lwr, log):
         identify_log(log, lwr, physical="yes")
     with pytest.raises(ValueError, match="^prior:"):
         identify_log(log, lwr, physical=True, prior=3)
+
+
+def test_identify_log_physical_with_excluded_joints_and_ols(lwr, log):
+    """Joint 1's rows left out (weight 0) and its torques replaced by garbage, OLS: joint 1's
+    own terms (Ia1, Fv1, Fs1, offset) are no longer excited, a RuntimeWarning (the least squares
+    would raise); the physical fit still explains joints 2-7 to 1e-6 of their torques and
+    ignores joint 1."""
+    log, offsets = log
+    tau = log.tau.copy()
+    tau[:, 0] = 50.0
+    garbage = log.replace(tau=tau)
+    with pytest.raises(dynid.RankDeficientError):
+        identify_log(garbage, lwr, rotor=True, friction=True, offset=True, exclude_joints=(0,))
+    with pytest.warns(RuntimeWarning, match="do not excite"):
+        result = identify_log(garbage, lwr, rotor=True, friction=True, offset=True,
+                              method="ols", exclude_joints=(0,), physical=True)
+    assert result.excluded == (0,) and result.physical["status"] == "optimal"
+    error = result.predict(garbage) - garbage.tau
+    assert np.abs(error[:, 1:]).max() < 1e-6 * np.abs(log.tau).max()
+    assert np.abs(error[:, 0]).max() > 1.0

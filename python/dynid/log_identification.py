@@ -204,7 +204,9 @@ def identify_log(
     least-squares residuals; the offsets unconstrained; excluded joints weighted 0). ``prior`` is a
     Robot or a model file (``dynid.load_model``: JSON/YAML or a built-in name) whose standard
     parameters are expressed in the DH frames of ``robot``; ``prior_weight`` defaults to
-    ``DEFAULT_PRIOR_WEIGHT`` when a prior is given. Raises
+    ``DEFAULT_PRIOR_WEIGHT`` when a prior is given. A log that does not excite every base
+    parameter is then a RuntimeWarning, not an error: the constraints and the prior fix the
+    unexcited directions (without a prior, any values the constraints allow). Raises
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):
@@ -238,7 +240,11 @@ def identify_log(
         _robot=robot,
     )
     Y = result.regressor(prepared.q, prepared.qd, prepared.qdd)
-    fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints)
+    # The physical fit needs the least squares only for the rank, the condition number and the
+    # WLS weights: directions the data do not excite are then fixed by the constraints and the
+    # prior, so rank deficiency is a warning there instead of an error.
+    fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints,
+                        on_rank_deficient="warn" if physical else "raise")
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.covariance = fit.covariance
