@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._checks import real_array
+from .link_frames import express_in_frames_of
 from .robot import Robot
 
 
@@ -56,29 +57,31 @@ def check_weights(weights: ArrayLike | None, T: int, n: int) -> NDArray[np.float
 
 
 def check_prior(prior: Any, robot: Robot, rotor: bool, friction: bool) -> NDArray[np.float64]:
+    """The prior's parameter vector in the robot's DH frames: as given when the two models have
+    the same regressor (a frame 0 moved along gravity, e.g. a base-to-shoulder height in d1,
+    keeps every link frame), else re-expressed by :func:`dynid.link_frames.express_in_frames_of`
+    (e.g. a URDF's or the other convention's table of the same arm)."""
     if not isinstance(prior, Robot):
         raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
             f"prior: expected a dynid.Robot, got {type(prior).__name__}")
-    if (prior.n, prior.joint_types, prior.convention) != (robot.n, robot.joint_types,
-                                                          robot.convention):
+    if (prior.n, prior.joint_types) != (robot.n, robot.joint_types):
         raise ValueError(
-            f"prior: expected a model with the robot's DH frames ({robot.n} joints "
-            f"{robot.joint_types!r}, {robot.convention} DH), got {prior.n} joints "
-            f"{prior.joint_types!r}, {prior.convention} DH")
-    # Same DH frames: the same regressor at random states (a prior whose frame 0 differs by a
-    # translation along gravity, e.g. d1 of a base-to-shoulder height, passes: its link frames
-    # are the robot's, so its standard parameters mean the same).
+            f"prior: expected a model of the robot's joints ({robot.n} joints "
+            f"{robot.joint_types!r}), got {prior.n} joints {prior.joint_types!r}")
+    bad = [f"link {i + 1}: {why}" for i in range(prior.n) if (why := prior._link_inconsistency(i))]
+    if bad:
+        raise ValueError("prior: expected a physically consistent model, " + "; ".join(bad))
     rng = np.random.default_rng(0)
     q = robot.random_configurations(4, seed=0)
     qd, qdd = rng.uniform(-1, 1, (2, 4, robot.n))
     mine, theirs = robot.regressor(q, qd, qdd), prior.regressor(q, qd, qdd)
     if not np.allclose(mine, theirs, rtol=1e-9, atol=1e-9 * np.abs(mine).max()):
-        raise ValueError("prior: its standard parameters are not expressed in the robot's DH "
-                         "frames (the two models' regressors differ); map the prior to the "
-                         "robot's DH table first")
-    bad = [f"link {i + 1}: {why}" for i in range(prior.n) if (why := prior._link_inconsistency(i))]
-    if bad:
-        raise ValueError("prior: expected a physically consistent model, " + "; ".join(bad))
+        try:
+            prior = express_in_frames_of(prior, robot)
+        except ValueError as exc:
+            raise ValueError(
+                "prior: its standard parameters are not in the robot's DH frames (the two "
+                f"regressors differ) and cannot be mapped to them: {exc}") from None
     values = prior.parameter_vector(rotor, friction)
     if np.any(values[10 * prior.n:] < 0):
         raise ValueError("prior: its Ia, Fv, Fs must be >= 0 (the estimate's are)")
