@@ -41,6 +41,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import scipy.linalg
+import scipy.linalg.lapack
 from numpy.typing import ArrayLike, NDArray
 
 from ._checks import positive
@@ -190,9 +192,7 @@ def physical_least_squares(
     b = (tau2 * w).reshape(-1)
     column = _column_norms(A)
     b_norm = float(np.linalg.norm(b)) or 1.0
-    Q, R = np.linalg.qr(A / column)
-    c = Q.T @ (b / b_norm)
-    r0 = float(np.sqrt(max(1.0 - c @ c, 0.0))) if np.any(b) else 0.0
+    R, c, r0 = _compressed(A / column, b / b_norm)
 
     J = [cp.Variable((4, 4), symmetric=True, name=f"J{i + 1}") for i in range(n)]
     drive_count = (n if rotor else 0) + (2 * n if friction else 0)
@@ -341,6 +341,22 @@ def _check(robot: Robot, min_eig: NDArray[np.float64]) -> float:
             f"(smallest eigenvalue {smallest:.3g} over {CHECK_CONFIGURATIONS} configurations)",
             "not_positive_definite")
     return smallest
+
+
+def _compressed(A: NDArray[np.float64], b: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """R, c = Q^T b and r0 with ||A z - b||^2 = ||R z - c||^2 + r0^2 for every z, from one
+    Householder QR of [A | b] without forming Q: its triangle is [[R, c], [0, r0]]."""
+    rows, columns = A.shape
+    # LAPACK's geqrf directly: scipy.linalg.qr(mode="r") would also zero the whole (rows, P)
+    # lower part, which costs as much as the factorisation here.
+    factor, _, _, info = scipy.linalg.lapack.dgeqrf(np.column_stack([A, b]), overwrite_a=True)
+    if info != 0:
+        raise ValueError(f"Y: the QR factorisation failed (LAPACK info {info})")
+    k = min(rows, columns)
+    R, c = np.triu(factor[:k, :columns]), factor[:k, columns].copy()
+    r0 = abs(float(factor[columns, columns])) if rows > columns else 0.0
+    return R, c, r0
 
 
 def _column_norms(A: NDArray[np.float64]) -> NDArray[np.float64]:
