@@ -4,7 +4,8 @@ The C++ core (``dynid._core``) computes kinematics, inverse and forward dynamics
 and Coriolis matrices and the regressors; this package holds the user's workflow on top of it,
 one way from the model to the files:
 
-- the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`;
+- the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`, :mod:`dynid.urdf`
+  (``Robot.from_urdf`` / ``Robot.to_urdf``);
 - its linear parametrisation: :mod:`~dynid.base_parameters`;
 - data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (a virtual robot);
 - identification: :mod:`~dynid.identify` (least squares), :mod:`~dynid.from_controller` (the
