@@ -90,3 +90,15 @@ def test_a_prior_in_other_frames_is_mapped_by_the_physical_fit():
     with pytest.raises(ValueError, match="^prior:"):
         physical_least_squares(lwr, Y, tau, prior=dynid.Robot.from_dh(dh, params=truth.params),
                                prior_weight=1e-4)
+
+
+def test_the_lwr4_urdf_maps_to_the_prior_file():
+    """Robot.from_urdf on the LWR4 URDF (its own DH: d1 = 1.3105 with a world offset, d7 =
+    0.078) mapped to kuka_lwr4()'s frames: the hand-made prior file's parameters to 1e-12, the
+    URDF's damping and friction as Fv, Fs."""
+    urdf = dynid.Robot.from_urdf(DATA / "urdf" / "kuka_lwr4.urdf")
+    mapped = express_in_frames_of(urdf, dynid.models.kuka_lwr4())
+    prior = dynid.load_model(PRIOR)
+    np.testing.assert_allclose(mapped.params, prior.params, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(mapped.Fv, prior.Fv)
+    np.testing.assert_array_equal(mapped.Fs, prior.Fs)

@@ -89,6 +89,18 @@ def test_physical_fit_validates_close_to_the_unconstrained_one(fits):
     np.testing.assert_allclose(masses, [2.7, 2.7, 2.7, 2.7, 1.7, 1.6, 0.3], atol=0.65)
 
 
+def test_the_urdf_itself_is_the_same_prior(fits, logs, lwr):
+    """prior = the LWR4 URDF file (read by Robot.from_urdf, mapped to kuka_lwr4()'s frames by the
+    fit): the same identified model as with the prior file (predictions to 1e-6 of the
+    torques; the solver's tolerance)."""
+    _, physical, _, _ = fits
+    train, check = logs
+    urdf = identify_log(train, lwr, **OPTIONS, physical=True,
+                        prior=DATA / "urdf" / "kuka_lwr4.urdf")
+    np.testing.assert_allclose(urdf.predict(check), physical.predict(check), rtol=0,
+                               atol=1e-6 * np.abs(check.tau).max())
+
+
 def test_physical_model_is_usable_where_the_unconstrained_one_is_not(fits, lwr):
     """The unconstrained base values mapped to standard parameters (minimum norm) give an M(q)
     that is indefinite at every one of 2000 random q (the issue's observation); the physical

@@ -202,8 +202,9 @@ def identify_log(
     ``physical=True`` estimates physically consistent standard parameters instead
     (:func:`dynid.physical_least_squares`, same columns; WLS weights 1/sigma_j from the
     least-squares residuals; the offsets unconstrained; excluded joints weighted 0). ``prior`` is a
-    Robot or a model file (``dynid.load_model``: JSON/YAML or a built-in name) whose standard
-    parameters are expressed in the DH frames of ``robot``; ``prior_weight`` defaults to
+    Robot, a URDF file or a model file (``dynid.load_model``: JSON/YAML or a built-in name) of
+    the same arm, in any DH table (re-expressed in ``robot``'s frames by
+    :func:`dynid.link_frames.express_in_frames_of` when needed); ``prior_weight`` defaults to
     ``DEFAULT_PRIOR_WEIGHT`` when a prior is given. A log that does not excite every base
     parameter is then a RuntimeWarning, not an error: the constraints and the prior fix the
     unexcited directions (without a prior, any values the constraints allow). Raises
@@ -304,90 +305,13 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
 
 
 def _prior_model(prior: Any) -> Robot:
-    """The prior: a Robot, or a model file / built-in name read by dynid.load_model (a URDF
-    path by Robot.from_urdf when it exists)."""
+    """The prior: a Robot, a URDF (``Robot.from_urdf``) or a model file / built-in name
+    (``dynid.load_model``)."""
     if isinstance(prior, Robot):
         return prior
     if not isinstance(prior, (str, Path)):
-        raise ValueError(f"prior: expected a dynid.Robot or the path of a model file, got "
-                         f"{type(prior).__name__}")
+        raise ValueError(f"prior: expected a dynid.Robot or the path of a model file or URDF, "
+                         f"got {type(prior).__name__}")
     if Path(prior).suffix.lower() == ".urdf":
-        if not hasattr(Robot, "from_urdf"):
-            raise ValueError(f"prior: {prior}: reading a URDF needs dynid.Robot.from_urdf")
         return Robot.from_urdf(prior)
     return load_model(prior)
-
-
-@dataclass(eq=False)
-class LogValidation(ValueEquality):
-    """An identified model applied to another log: the prepared log, the predicted torques and
-    the per-joint errors (:func:`dynid.validation.error_metrics`)."""
-
-    log: Log  #: the validation log after ``preparation``
-    predicted: NDArray[np.float64]
-    metrics: dict[str, NDArray[np.float64]]
-    preparation: dict[str, Any]
-    notes: list[str] = field(default_factory=list)  #: differences from the training preparation
-
-
-def run_validation(
-    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
-) -> LogValidation:
-    """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
-    and measure the errors; ``notes`` says where the preparation differs from the training
-    log's (a low-pass on one and not the other biases the comparison)."""
-    options = _options(preparation)
-    prepared = prepare_log(log, **options) if options else log
-    predicted = result.predict(prepared)
-    notes = []
-    trained = result.training.get("preparation", {}).get("cutoff")
-    if trained != options.get("cutoff"):
-        notes.append(f"the training log was {_filtered(trained)}, this one is "
-                     f"{_filtered(options.get('cutoff'))}")
-    return LogValidation(prepared, predicted, error_metrics(prepared.tau, predicted), options,
-                         notes)
-
-
-def validate_log(
-    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
-) -> dict[str, NDArray[np.float64]]:
-    """Per-joint errors of ``result`` on another log (``prepare_log(log, **preparation)``
-    first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
-    ``r2`` and ``mse`` (see :func:`dynid.validation.error_metrics`)."""
-    return run_validation(result, log, preparation=preparation).metrics
-
-
-def _filtered(cutoff: float | None) -> str:
-    return "not low-passed" if cutoff is None else f"low-passed at {cutoff:g} Hz"
-
-
-def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:
-    """The prepare_log options given (None values left out), checked by name."""
-    options = {k: v for k, v in dict(preparation or {}).items() if v is not None}
-    unknown = sorted(set(options) - set(PREPARATION))
-    if unknown:
-        raise ValueError(f"preparation: unknown option(s) {unknown}; expected some of "
-                         f"{', '.join(PREPARATION)} (dynid.io.prepare_log)")
-    return options
-
-
-def _plain(value: Any) -> Any:
-    """A JSON-ready record of an option value (a callable reference torque by its name)."""
-    if callable(value):
-        return f"<{getattr(value, '__name__', type(value).__name__)}>"
-    array = np.asarray(value)
-    if array.dtype.kind not in "biuf":
-        return str(value)
-    return array.tolist() if array.size <= 64 else f"<array of shape {array.shape}>"
-
-
-def _with_derivatives(log: Log, n: int, name: str) -> Log:
-    if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
-            f"log: expected a dynid.io.Log, got {type(log).__name__}"
-        )
-    if log.n != n:
-        raise ValueError(f"log: has {log.n} joints, but the model {name!r} has {n}")
-    if log.qd is None or log.qdd is None:
-        log = prepare_log(log, differentiate="missing")
-    return log
