@@ -315,3 +315,78 @@ def _prior_model(prior: Any) -> Robot:
     if Path(prior).suffix.lower() == ".urdf":
         return Robot.from_urdf(prior)
     return load_model(prior)
+
+
+@dataclass(eq=False)
+class LogValidation(ValueEquality):
+    """An identified model applied to another log: the prepared log, the predicted torques and
+    the per-joint errors (:func:`dynid.validation.error_metrics`)."""
+
+    log: Log  #: the validation log after ``preparation``
+    predicted: NDArray[np.float64]
+    metrics: dict[str, NDArray[np.float64]]
+    preparation: dict[str, Any]
+    notes: list[str] = field(default_factory=list)  #: differences from the training preparation
+
+
+def run_validation(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> LogValidation:
+    """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
+    and measure the errors; ``notes`` says where the preparation differs from the training
+    log's (a low-pass on one and not the other biases the comparison)."""
+    options = _options(preparation)
+    prepared = prepare_log(log, **options) if options else log
+    predicted = result.predict(prepared)
+    notes = []
+    trained = result.training.get("preparation", {}).get("cutoff")
+    if trained != options.get("cutoff"):
+        notes.append(f"the training log was {_filtered(trained)}, this one is "
+                     f"{_filtered(options.get('cutoff'))}")
+    return LogValidation(prepared, predicted, error_metrics(prepared.tau, predicted), options,
+                         notes)
+
+
+def validate_log(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> dict[str, NDArray[np.float64]]:
+    """Per-joint errors of ``result`` on another log (``prepare_log(log, **preparation)``
+    first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
+    ``r2`` and ``mse`` (see :func:`dynid.validation.error_metrics`)."""
+    return run_validation(result, log, preparation=preparation).metrics
+
+
+def _filtered(cutoff: float | None) -> str:
+    return "not low-passed" if cutoff is None else f"low-passed at {cutoff:g} Hz"
+
+
+def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The prepare_log options given (None values left out), checked by name."""
+    options = {k: v for k, v in dict(preparation or {}).items() if v is not None}
+    unknown = sorted(set(options) - set(PREPARATION))
+    if unknown:
+        raise ValueError(f"preparation: unknown option(s) {unknown}; expected some of "
+                         f"{', '.join(PREPARATION)} (dynid.io.prepare_log)")
+    return options
+
+
+def _plain(value: Any) -> Any:
+    """A JSON-ready record of an option value (a callable reference torque by its name)."""
+    if callable(value):
+        return f"<{getattr(value, '__name__', type(value).__name__)}>"
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        return str(value)
+    return array.tolist() if array.size <= 64 else f"<array of shape {array.shape}>"
+
+
+def _with_derivatives(log: Log, n: int, name: str) -> Log:
+    if not isinstance(log, Log):
+        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+            f"log: expected a dynid.io.Log, got {type(log).__name__}"
+        )
+    if log.n != n:
+        raise ValueError(f"log: has {log.n} joints, but the model {name!r} has {n}")
+    if log.qd is None or log.qdd is None:
+        log = prepare_log(log, differentiate="missing")
+    return log
