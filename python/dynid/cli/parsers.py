@@ -87,8 +87,8 @@ def _add_info(subcommands: Any) -> None:
 
 def _add_model(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default=DEFAULT_MODEL, metavar="NAME|FILE",
-                   help="built-in model (kuka_lwr4, puma560, planar_2r) or a model file, JSON "
-                   f"or YAML (docs/cli.md); default {DEFAULT_MODEL}")
+                   help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
+                   f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}")
 
 
 def _add_preparation(p: argparse.ArgumentParser) -> None:
