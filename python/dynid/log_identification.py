@@ -305,15 +305,13 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
 
 
 def _prior_model(prior: Any) -> Robot:
-    """The prior: a Robot, a URDF (``Robot.from_urdf``) or a model file / built-in name
-    (``dynid.load_model``)."""
+    """The prior: a Robot, or what ``dynid.load_model`` reads (a model file, a URDF, a built-in
+    name)."""
     if isinstance(prior, Robot):
         return prior
     if not isinstance(prior, (str, Path)):
         raise ValueError(f"prior: expected a dynid.Robot or the path of a model file or URDF, "
                          f"got {type(prior).__name__}")
-    if Path(prior).suffix.lower() == ".urdf":
-        return Robot.from_urdf(prior)
     return load_model(prior)
 
 
