@@ -104,7 +104,7 @@ class PhysicalResult(ValueEquality):
     objective: float  #: the cost minimised (relative squared residual + prior term)
     solver: str
     solve_time: float  #: seconds in the solver (cvxpy's report)
-    setup_time: float  #: seconds building the problem (compression, cvxpy canonicalisation)
+    setup_time: float  #: seconds outside the solver: checks, compression, cvxpy's compilation
     min_eigenvalues: NDArray[np.float64]  #: (n,) smallest eigenvalue of each link's J_i
     min_mass_matrix_eigenvalue: float  #: smallest eigenvalue of M(q) over the checked q
     projected: tuple[int, ...] = ()  #: links (0-based) moved onto the margin after the solve
@@ -145,9 +145,11 @@ def physical_least_squares(
         WLS is w_j = 1 / sigma_j, sigma_j the joint's noise standard deviation. Non-negative,
         at least one positive.
     prior, prior_weight
-        A physically consistent Robot with the same DH frames (n, joint types, convention) and
-        the weight of the distance to it (module docstring); the directions the data cannot see
-        come from it. prior_weight > 0 needs a prior, a prior needs prior_weight > 0.
+        A physically consistent Robot of the same arm (same joints; in any DH table: its
+        parameters are re-expressed in robot's frames when its regressor differs, see
+        :func:`dynid.link_frames.express_in_frames_of`) and the weight of the distance to it
+        (module docstring); the directions the data cannot see come from it. prior_weight > 0
+        needs a prior, a prior needs prior_weight > 0.
     mass_bounds
         (n, 2) lower and upper bound on each link's mass in kg (upper may be inf).
     total_mass
@@ -214,13 +216,15 @@ def physical_least_squares(
     if prior_x is not None:
         terms += _prior_terms(J, drive, prior_x, prior_weight, Y3, tau2, n, rotor, friction)
     problem = cp.Problem(cp.Minimize(cp.norm(cp.hstack(terms), 2)), constraints)
-    setup = time.perf_counter() - started
     try:
         problem.solve(solver=SOLVER)
     except cp.error.SolverError as exc:
         raise PhysicalIdentificationError(
             f"the physically consistent fit failed: the solver {SOLVER} stopped with an error "
             f"({exc}); no model is returned", "solver_error") from None
+    solve_time = problem.solver_stats.solve_time
+    solve_time = float(solve_time) if solve_time is not None else float("nan")
+    setup = time.perf_counter() - started - (solve_time if np.isfinite(solve_time) else 0.0)
     status = str(problem.status)
     if status != cp.OPTIMAL:
         why = {cp.INFEASIBLE: " (the constraints cannot all hold: check mass_bounds, total_mass "
@@ -254,7 +258,6 @@ def physical_least_squares(
     mass_eig = _check(identified, min_eig)
     base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
     residual = tau2 - Y3 @ theta
-    solve_time = problem.solver_stats.solve_time
     return PhysicalResult(
         robot=identified, params=params,
         Ia=drive_values[:n].copy() if rotor else None,
@@ -263,7 +266,7 @@ def physical_least_squares(
         extra=extra, theta=theta, base_values=base.beta @ theta[:P], base_names=list(base.names),
         residual_rms=np.sqrt(np.mean(residual**2, axis=0)), status=status,
         objective=float(problem.value) ** 2, solver=SOLVER,
-        solve_time=float(solve_time) if solve_time is not None else float("nan"),
+        solve_time=solve_time,
         setup_time=setup, min_eigenvalues=min_eig, min_mass_matrix_eigenvalue=mass_eig,
         projected=tuple(projected), projection=worst,
         options={"rotor": rotor, "friction": friction, "prior_weight": prior_weight,
