@@ -12,6 +12,7 @@ one way from the model to the files:
   paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
   :mod:`~dynid.recursive`;
 - checking the result: :mod:`~dynid.validation`, :mod:`~dynid.plots`;
+- uses of the model: :mod:`~dynid.time_scaling`, :mod:`~dynid.bounds`, :mod:`~dynid.payload`;
 - files: :mod:`dynid.io` (model and result files); the command line: :mod:`dynid.cli`.
 
 Names are loaded on first use (PEP 562), so ``import dynid`` stays fast: SciPy's optimisers and
@@ -33,6 +34,7 @@ from .robot import Robot
 
 if TYPE_CHECKING:
     from . import models
+    from .bounds import DynamicBounds, dynamic_bounds
     from .cmake import get_cmake_dir, get_include
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
@@ -42,9 +44,11 @@ if TYPE_CHECKING:
     from .io.preparation import prepare_log
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
+    from .payload import PayloadEstimate, estimate_payload, payload_from_identified
     from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
     from .sim import VirtualController
+    from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 #: Public name -> the module that defines it (imported on first access).
 _LAZY = {
@@ -80,6 +84,15 @@ _LAZY = {
     "physical_least_squares": ".physical",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
+    "DynamicBounds": ".bounds",
+    "dynamic_bounds": ".bounds",
+    "PayloadEstimate": ".payload",
+    "estimate_payload": ".payload",
+    "payload_from_identified": ".payload",
+    "scale_time": ".time_scaling",
+    "scale_motion": ".time_scaling",
+    "scale_torques": ".time_scaling",
+    "scaling_for_torque_limits": ".time_scaling",
 }
 
 __all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",
