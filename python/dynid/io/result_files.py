@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from .._version import dynid_version
 from ..log_identification import LogIdentification, LogValidation
 from .log_files import Log
-from .model_files import dumps_json, model_from_dict
+from .model_files import dumps_json, load_model, model_from_dict
 from .output_folder import output_folder
 
 PathLike = Union[str, Path]
@@ -305,3 +305,25 @@ def _has_bool(value: Any) -> bool:
     if isinstance(value, bool):
         return True
     return isinstance(value, list) and any(_has_bool(v) for v in value)
+
+
+def export_robot(
+    source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
+) -> Path:
+    """Write the robot of ``source`` as a URDF file (``dynid export``): ``source`` is a result
+    folder or ``result.json`` of a physically consistent identification, or anything
+    :func:`~dynid.io.model_files.load_model` reads (a built-in name, a model file, a URDF).
+    A least-squares result holds base parameters only, not a robot: a ValueError says so."""
+    path = Path(source)
+    if path.is_dir() or path.name == RESULT_FILE:
+        result = load_result(path)
+        if result.physical is None:
+            raise ValueError(
+                f"{path}: a least-squares result holds base parameters only, not a full robot; "
+                "identify with --physical (dynid identify LOG --physical) to export a model"
+            )
+        robot = result.robot
+    else:
+        robot = load_model(source)
+    robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
+    return Path(urdf)
