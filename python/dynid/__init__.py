@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
     from .payload import PayloadEstimate, estimate_payload, payload_from_identified
+    from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
     from .sim import VirtualController, simulate
     from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
@@ -79,6 +80,9 @@ _LAZY = {
     "LogIdentification": ".log_identification",
     "identify_log": ".log_identification",
     "validate_log": ".log_identification",
+    "PhysicalIdentificationError": ".physical",
+    "PhysicalResult": ".physical",
+    "physical_least_squares": ".physical",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
     "simulate": ".sim",
