@@ -183,6 +183,12 @@ int main() {
   expect_rejected("RecursiveLeastSquares", "theta0", [&] { rls.reset(VectorX::Zero(3), MatrixX::Identity(4, 4)); }, false);
   expect_rejected("RecursiveLeastSquares", "P0", [&] { rls.reset(VectorX::Zero(4), MatrixX::Identity(3, 3)); }, false);
 
+  dynid::Simulator simulator(model, dynid::SimulationSettings{});
+  expect_rejected("Simulator::acceleration", "q", [&] { simulator.acceleration(short_vector, qd, tau, qdd_out); });
+  expect_rejected("Simulator::acceleration", "qd", [&] { simulator.acceleration(q, long_vector, tau, qdd_out); });
+  expect_rejected("Simulator::acceleration", "tau", [&] { simulator.acceleration(q, qd, short_vector, qdd_out); });
+  expect_rejected("Simulator::acceleration", "qdd", [&] { simulator.acceleration(q, qd, tau, short_out); });
+
   // ---- the right sizes work, and agree with independent routes ----
   dynid::rnea(model, ws, q, qd, qdd, tau);
   dynid::crba(model, ws, q, M);
@@ -195,6 +201,11 @@ int main() {
   expect_close("coriolis = S qd", (S * qd - c).cwiseAbs().maxCoeff());
   dynid::forward_dynamics(model, ws, q, qd, tau, qdd_out);
   expect_close("forward_dynamics(rnea) = qdd", (qdd_out - qdd).cwiseAbs().maxCoeff());
+  dynid::SimulationSettings sign_friction;
+  sign_friction.coulomb_band = 0.0;  // the exact sign(qd) of rnea
+  dynid::Simulator exact(model, sign_friction);
+  exact.acceleration(q, qd, tau, qdd_out);
+  expect_close("Simulator::acceleration(rnea) = qdd", (qdd_out - qdd).cwiseAbs().maxCoeff());
   VectorX pi(P);
   for (int i = 0; i < n; ++i) pi.segment(10 * i, 10) = model.parameters().row(i).transpose();
   pi.segment(10 * n, n) = model.rotor_inertia();

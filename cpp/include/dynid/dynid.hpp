@@ -2,6 +2,7 @@
 // Every public header is included here; dynid/detail/ holds the internals (not API).
 #pragma once
 
+#include "dynid/controllers.hpp"
 #include "dynid/coriolis.hpp"
 #include "dynid/coriolis_matrix.hpp"
 #include "dynid/crba.hpp"
@@ -15,5 +16,6 @@
 #include "dynid/regressor.hpp"
 #include "dynid/rigid_body.hpp"
 #include "dynid/rnea.hpp"
+#include "dynid/simulator.hpp"
 #include "dynid/types.hpp"
 #include "dynid/workspace.hpp"
