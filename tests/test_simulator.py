@@ -434,7 +434,7 @@ def test_the_documented_example_runs():
 
 # The sources the simulator and its controllers need.
 CORE_SOURCES = ("simulator", "controllers", "rnea", "crba", "gravity", "kinematics", "model",
-                "workspace", "rigid_body", "energy")
+                "workspace", "rigid_body", "energy", "argument_checks")
 
 
 def find_compiler() -> str | None:
