@@ -22,7 +22,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from ._core import get_threads, set_threads
+from ._core import MomentumObserver, get_threads, set_threads
 from ._version import __version__
 
 # Imported here, not lazily: the submodule of the same name would otherwise shadow the function
@@ -75,10 +75,11 @@ _LAZY = {
     "validate_log": ".log_identification",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
+    "observer": ".observer",
 }
 
-__all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",
-                  "__version__"])
+__all__ = sorted([*_LAZY, "BaseParameters", "MomentumObserver", "Robot", "base_parameters",
+                  "get_threads", "set_threads", "__version__"])
 
 
 def __getattr__(name: str) -> Any:
