@@ -188,8 +188,8 @@ const Eigen::VectorXd& PinocchioSide::g() const { return impl_->data.g; }
 const Eigen::MatrixXd& PinocchioSide::C() const { return impl_->data.C; }
 const Eigen::MatrixXd& PinocchioSide::Y() const { return impl_->data.jointTorqueRegressor; }
 const Eigen::VectorXd& PinocchioSide::qdd() const { return impl_->data.ddq; }
-const Eigen::MatrixXd& PinocchioSide::dtau_dq() const { return impl_->data.dtau_dq; }
-const Eigen::MatrixXd& PinocchioSide::dtau_dqd() const { return impl_->data.dtau_dv; }
+const PinocchioSide::RowMatrixXd& PinocchioSide::dtau_dq() const { return impl_->data.dtau_dq; }
+const PinocchioSide::RowMatrixXd& PinocchioSide::dtau_dqd() const { return impl_->data.dtau_dv; }
 
 Eigen::MatrixXd PinocchioSide::regressor_map() const {
   const int n = impl_->arm.n();
