@@ -163,8 +163,9 @@ def test_bad_input_raises_value_error_naming_argument(call, name):
 
 # ----------------------------------------------------------------------------- real data
 
-def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property):
+def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property, tmp_path):
     from dynid.io import load_log
+    from dynid.io.result_files import load_result, save_result
     from dynid.log_identification import identify_log
     from dynid.observer import residual_from_log, robot_from_identification
 
@@ -190,6 +191,10 @@ def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property):
     record_property("residual_rms", residual.rms.tolist())
     assert np.all(difference < 0.03)
     assert np.all(residual.rms < 1.1 * np.sqrt(np.mean(model_error**2, axis=0)))
+    # a result read back from its files (what a CLI gets) gives the same residual
+    save_result(result, tmp_path / "result")
+    again = residual_from_log(load_result(tmp_path / "result"), check, gain)
+    np.testing.assert_allclose(again.r, residual.r, rtol=0, atol=1e-9)
 
 
 def test_residual_files_and_plot(tmp_path, contact_run):
