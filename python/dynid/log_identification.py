@@ -28,6 +28,7 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
+from ._equality import ValueEquality
 from .base_parameters import base_parameters
 from .identify import least_squares
 from .io.log_files import Log
@@ -47,7 +48,7 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 
 @dataclass(eq=False)
-class LogIdentification:
+class LogIdentification(ValueEquality):
     """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
@@ -73,9 +74,12 @@ class LogIdentification:
     condition_number: float
     rank: int
     excluded: tuple[int, ...] = ()
+    #: (count, count) covariance of ``theta`` (None for results saved before format version 2)
+    covariance: NDArray[np.float64] | None = None
     training: dict[str, Any] = field(default_factory=dict)
-    log: Log | None = field(default=None, repr=False)  #: the prepared training log (not saved)
-    _robot: Robot | None = field(default=None, repr=False)
+    #: the prepared training log (not saved, not compared)
+    log: Log | None = field(default=None, repr=False, compare=False)
+    _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
     def n(self) -> int:
@@ -193,6 +197,7 @@ def identify_log(
     fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints)
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
+    result.covariance = fit.covariance
     result.excluded = fit.excluded
     for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
         result.model.pop(key, None)
@@ -209,7 +214,7 @@ def identify_log(
 
 
 @dataclass(eq=False)
-class LogValidation:
+class LogValidation(ValueEquality):
     """An identified model applied to another log: the prepared log, the predicted torques and
     the per-joint errors (:func:`dynid.validation.error_metrics`)."""
 

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import signal as _sp
 from scipy.ndimage import median_filter
 
-from ._checks import positive, positive_int, real_array
+from ._checks import is_integer, positive, positive_int, real_array
 
 #: Anti-aliasing cutoff of :func:`decimate` as a fraction of the new Nyquist frequency (the value
 #: scipy.signal.decimate uses): the band kept is undistorted, the band folded back is attenuated.
@@ -49,7 +49,7 @@ def _array(x: ArrayLike, name: str, min_ndim: int = 1) -> NDArray[np.float64]:
 
 
 def _axis(x: NDArray, axis: int, name: str = "x") -> int:
-    if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)):
+    if not is_integer(axis):
         raise ValueError(f"axis: expected an integer, got {axis!r}")  # noqa: TRY004
     if not -x.ndim <= axis < x.ndim:
         raise ValueError(f"axis: {axis} is out of range for {name} with shape {x.shape}")
@@ -192,11 +192,22 @@ def differentiate(
         raise ValueError(f"x: expected at least 2 samples along axis {ax}, got {length}")
     edge_order = 2 if length >= 3 else 1
     if fs is not None:
-        return np.gradient(arr, 1.0 / positive(fs, "fs"), axis=ax, edge_order=edge_order)
+        step = 1.0 / positive(fs, "fs")
+        return _finite_result(np.gradient, arr, step, axis=ax, edge_order=edge_order)
     t = check_time(t)
     if t.size != length:
         raise ValueError(f"t: has {t.size} samples but x has {length} along axis {ax}")
-    return np.gradient(arr, t, axis=ax, edge_order=edge_order)
+    return _finite_result(np.gradient, arr, t, axis=ax, edge_order=edge_order)
+
+
+def _finite_result(gradient: Any, arr: NDArray, *args: Any, **kwargs: Any) -> NDArray:
+    # Differences of huge finite values (or tiny time steps) overflow: a ValueError naming the
+    # input, never inf/NaN with only a RuntimeWarning.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        result = gradient(arr, *args, **kwargs)
+    if not np.all(np.isfinite(result)):
+        raise ValueError("x: the derivative overflows (values too large for their time steps)")
+    return result
 
 
 # --------------------------------------------------------------------------- decimation
@@ -218,7 +229,7 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
     low-passed at a lower cutoff). A time vector must not be filtered: subsample
     ``t[::factor]`` yourself, or decimate a whole log with :func:`dynid.io.preparation.decimate_log`.
     """
-    if factor is None and len(data) >= 2 and _is_integer(data[-1]):
+    if factor is None and len(data) >= 2 and is_integer(data[-1]):
         data, factor = data[:-1], data[-1]
     if factor is None:
         raise ValueError("factor: missing; call decimate(x, factor)")
@@ -239,10 +250,6 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
 
     out = tuple(one(x, f"data[{i}]") for i, x in enumerate(data))
     return out[0] if len(out) == 1 else out
-
-
-def _is_integer(value: Any) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
 
 
 # --------------------------------------------------------------------------- masks

@@ -19,6 +19,14 @@ def _steps(total: int) -> Callable[[str], None]:
     return step
 
 
+def log_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``load_log`` options given on the command line."""
+    from ..io.columns import parse_columns
+
+    columns = parse_columns(args.columns) if args.columns is not None else None
+    return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+
+
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
     """The ``prepare_log`` options given on the command line."""
     options: dict[str, Any] = {"cutoff": args.cutoff, "decimate": args.decimate}
@@ -45,7 +53,7 @@ def identify(args: argparse.Namespace) -> None:
 
     check_output_path(args.output, args.overwrite)  # before the work, not after
     step = _steps(5)
-    log = load_log(args.log, skip=args.skip)
+    log = load_log(args.log, **log_options(args))
     step(f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
          + (f" (first {args.skip} skipped)" if args.skip else ""))
     robot = load_model(args.model)
@@ -71,7 +79,7 @@ def validate(args: argparse.Namespace) -> None:
     check_output_path(args.output, args.overwrite)
     step = _steps(3)
     result = load_result(args.result)
-    log = load_log(args.log, skip=args.skip)
+    log = load_log(args.log, **log_options(args))
     validation = run_validation(result, log, preparation=preparation_options(args))
     step(f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
          f"log {args.log}: {validation.log.T} samples")

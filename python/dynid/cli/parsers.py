@@ -87,13 +87,18 @@ def _add_info(subcommands: Any) -> None:
 
 def _add_model(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default=DEFAULT_MODEL, metavar="NAME|FILE",
-                   help="built-in model (kuka_lwr4, puma560, planar_2r) or a model file, JSON "
-                   f"or YAML (docs/cli.md); default {DEFAULT_MODEL}")
+                   help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
+                   f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}")
 
 
 def _add_preparation(p: argparse.ArgumentParser) -> None:
     p.add_argument("--skip", type=int, default=0, metavar="N",
                    help="drop the first N samples (start-up transient)")
+    p.add_argument("--columns", metavar="MAP",
+                   help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
+                   "(glob patterns, joints in natural order; docs/data.md)")
+    p.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s",
+                   help="unit of the log's time stamps (default s)")
     p.add_argument("--cutoff", type=float, metavar="HZ",
                    help="zero-phase Butterworth low-pass of q, qd, qdd, tau at HZ")
     p.add_argument("--order", type=int, default=4, help="order of that filter (default 4)")

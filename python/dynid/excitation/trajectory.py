@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._checks import real_array
+from .._checks import count, real_array
 from ..base_parameters import base_parameters
 from ..robot import Robot
 
@@ -87,9 +87,14 @@ class FourierTrajectory:
         times = _finite_array(t, "t")
         if times.ndim > 1:
             raise ValueError(f"t: expected a scalar or shape (T,), got {times.shape}")
-        Bq, Bqd, Bqdd = _basis(np.atleast_1d(times), self.base_frequency, self.harmonics)
         c = np.hstack([self.a, self.b])
-        q, qd, qdd = Bq @ c.T + self.q0, Bqd @ c.T, Bqdd @ c.T
+        with np.errstate(over="ignore", invalid="ignore"):
+            Bq, Bqd, Bqdd = _basis(np.atleast_1d(times), self.base_frequency, self.harmonics)
+            q, qd, qdd = Bq @ c.T + self.q0, Bqd @ c.T, Bqdd @ c.T
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):
+            # Finite but huge coefficients or times overflow: an error, never a silent NaN.
+            raise ValueError("t: q, qd or qdd overflow at these times with this trajectory's "
+                             "coefficients (a, b, q0, base_frequency); use smaller values")
         if times.ndim == 0:
             return q[0], qd[0], qdd[0]
         return q, qd, qdd
@@ -288,11 +293,7 @@ def _finite_positive(value: object, name: str) -> float:
 
 
 def _integer(value: object, name: str, minimum: int) -> int:
-    # SPEC section 2: a wrong type is a ValueError too; True is not an integer here
-    integral = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-    if integral and value >= minimum:
-        return int(value)
-    raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return count(value, name, minimum)
 
 
 def _limit_vector(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:

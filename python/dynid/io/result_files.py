@@ -26,7 +26,11 @@ from .output_folder import output_folder
 PathLike = Union[str, Path]
 
 FORMAT = "dynid-identification"
-VERSION = 1
+#: Format version written; the loader reads versions 1 (no covariance) to VERSION.
+VERSION = 2
+#: Units of what a result holds (written into result.json for readers other than dynid).
+UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "torque": "N m",
+         "coefficients": "SI, as their expressions over the standard parameters"}
 RESULT_FILE = "result.json"
 VALIDATION_FORMAT = "dynid-validation"
 VALIDATION_FILE = "validation.json"
@@ -127,6 +131,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     return {
         "format": FORMAT,
         "version": VERSION,
+        "dynid_version": dynid_version(),
+        "units": UNITS,
         "model": result.model,
         "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
                     "method": result.method, "exclude_joints": list(result.excluded)},
@@ -134,6 +140,7 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         "rank": result.rank,
         "coefficients": coefficients,
         "training": training,
+        "covariance": _nums(result.covariance) if result.covariance is not None else None,
         "base_parameters": {
             "count": result.count,
             "parameter_names": result.parameter_names,
@@ -149,6 +156,11 @@ def result_from_dict(data: Any) -> LogIdentification:
     if data.get("format") != FORMAT:
         raise ValueError(f"format: expected {FORMAT!r} (a dynid identify result), got "
                          f"{data.get('format')!r}")
+    version = data.get("version")
+    if not (isinstance(version, int) and not isinstance(version, bool) and 1 <= version <= VERSION):
+        raise ValueError(f"version: expected a format version 1..{VERSION} (written by dynid "
+                         f"{data.get('dynid_version', '?')}; this is dynid {dynid_version()}), "
+                         f"got {version!r}")
     model = _object(_get(data, "model"), "model")
     try:
         robot = model_from_dict(model)
@@ -206,8 +218,18 @@ def result_from_dict(data: Any) -> LogIdentification:
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
+        covariance=_covariance(data.get("covariance"), count + (robot.n if flags["offset"] else 0)),
         _robot=robot,
     )
+
+
+def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
+    if value is None:
+        return None
+    covariance = _array(value, "covariance", 2, nullable=True)
+    if covariance.shape != (size, size):
+        raise ValueError(f"covariance: expected shape ({size}, {size}), got {covariance.shape}")
+    return covariance
 
 
 def metrics_to_dict(metrics: dict[str, NDArray[np.float64]]) -> dict[str, list]:
