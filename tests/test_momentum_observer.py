@@ -106,12 +106,12 @@ def test_residual_tracks_the_external_torque_with_the_observer_time_constant(con
     # one time constant after the contact starts: 1 - 1/e of tau_ext (slowly varying), per joint
     K = np.broadcast_to(gain, (robot.n,))
     for j in range(robot.n):
-        k = int(round((T_ON + 1.0 / K[j]) / DT))
+        k = round((T_ON + 1.0 / K[j]) / DT)
         np.testing.assert_allclose(r[k, j] / tau_ext[k, j], 1 - np.exp(-1), atol=0.03)
 
 
 def test_update_run_reset_and_properties(contact_run):
-    robot, t, q, qd, tau, _ = contact_run
+    robot, _t, q, qd, tau, _ = contact_run
     observer = dynid.MomentumObserver(robot, 40.0, DT)
     assert observer.n == robot.n and observer.dt == DT and observer.samples == 0
     np.testing.assert_array_equal(observer.gain, np.full(robot.n, 40.0))
@@ -130,7 +130,7 @@ def test_update_run_reset_and_properties(contact_run):
 
 
 def test_the_model_is_copied(contact_run):
-    robot, t, q, qd, tau, _ = contact_run
+    robot, _t, q, qd, tau, _ = contact_run
     robot = robot.copy()
     observer = dynid.MomentumObserver(robot, 40.0, DT)
     expected = observer.run(q[:50], qd[:50], tau[:50])

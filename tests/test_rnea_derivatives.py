@@ -15,12 +15,13 @@ from pathlib import Path
 
 import dynid
 import numpy as np
+import pinocchio as pin  # the test extra's "pin"
 import pytest
 from conftest import ARM_CASES, make_arm, random_state
 
-pin = pytest.importorskip("pinocchio")  # in the test extra ("pin"); skipped only where missing
+# bench/pinocchio_arm.py: the Pinocchio model of a dynid DH arm, built without dynid's code
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
-from pinocchio_arm import build_model  # noqa: E402  (bench/, the Pinocchio model of a DH arm)
+from pinocchio_arm import build_model
 
 FD_STEP = 1e-6
 FD_RTOL = 1e-7
