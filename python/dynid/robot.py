@@ -26,7 +26,8 @@ class Robot(_core.Model):
     Build one with :meth:`Robot.from_dh` or take one from :mod:`dynid.models`. The dynamics
     methods (``rnea``, ``mass_matrix``, ``gravity``, ``coriolis``, ``coriolis_matrix``,
     ``friction``, ``forward_dynamics``, ``kinetic_energy``, ``potential_energy``, ``fkine``,
-    ``jacobian``) accept one sample (n,) or T samples (T, n).
+    ``jacobian``, and SPEC section 8's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
+    ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
     """
 
     def __init__(
