@@ -58,7 +58,7 @@ void bind_uses(py::module_& m) {
       py::arg("q"), py::arg("qd"), py::arg("qdd"),
       "Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, "
       "n, n) each for T samples (Carpentier & Mansard 2018); dtau_dqd includes diag(Fv), dtau/dqdd "
-      "is mass_matrix(q).");
+      "is mass_matrix(q). Both are views into one (2, n, n) or (T, 2, n, n) array.");
   model.def(
       "jacobian_dot",
       [](PyModel& self, py::handle q, py::handle qd) {
