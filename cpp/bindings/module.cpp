@@ -5,6 +5,7 @@
 
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
+#include "simulator.hpp"
 #include "uses.hpp"
 
 namespace py = pybind11;
@@ -14,6 +15,7 @@ PYBIND11_MODULE(_core, m) {
   dynid::binding::bind_model(m);
   dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
   dynid::binding::bind_recursive_least_squares(m);
+  dynid::binding::bind_simulator(m);
   m.def(
       "standard_parameters",
       [](double mass, py::handle com, py::handle inertia_com) {

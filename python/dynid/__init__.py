@@ -7,7 +7,8 @@ one way from the model to the files:
 - the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`, :mod:`dynid.urdf`
   (``Robot.from_urdf`` / ``Robot.to_urdf``);
 - its linear parametrisation: :mod:`~dynid.base_parameters`;
-- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (a virtual robot);
+- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (closed-loop
+  simulation, a virtual robot);
 - identification: :mod:`~dynid.identify` (least squares), :mod:`~dynid.from_controller` (the
   paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
   :mod:`~dynid.recursive`;
@@ -45,8 +46,9 @@ if TYPE_CHECKING:
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
     from .payload import PayloadEstimate, estimate_payload, payload_from_identified
+    from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
-    from .sim import VirtualController
+    from .sim import VirtualController, simulate
     from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 #: Public name -> the module that defines it (imported on first access).
@@ -78,8 +80,12 @@ _LAZY = {
     "LogIdentification": ".log_identification",
     "identify_log": ".log_identification",
     "validate_log": ".log_identification",
+    "PhysicalIdentificationError": ".physical",
+    "PhysicalResult": ".physical",
+    "physical_least_squares": ".physical",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
+    "simulate": ".sim",
     "DynamicBounds": ".bounds",
     "dynamic_bounds": ".bounds",
     "PayloadEstimate": ".payload",

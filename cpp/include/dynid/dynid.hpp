@@ -1,6 +1,7 @@
 // Everything a C++ user needs: build a Model, make a Workspace per thread, call the algorithms.
 #pragma once
 
+#include "dynid/controllers.hpp"
 #include "dynid/coriolis.hpp"
 #include "dynid/coriolis_matrix.hpp"
 #include "dynid/crba.hpp"
@@ -15,4 +16,5 @@
 #include "dynid/regressor.hpp"
 #include "dynid/rnea.hpp"
 #include "dynid/rnea_derivatives.hpp"
+#include "dynid/simulator.hpp"
 #include "dynid/workspace.hpp"

@@ -106,7 +106,7 @@ def write_urdf(text: str, path: str | Path, overwrite: bool = False) -> Path:
     if target.is_dir():
         raise ValueError(f"path: {target} is a folder")
     if target.exists() and not overwrite:
-        raise ValueError(f"path: {target} exists; pass overwrite=True to replace it")
+        raise ValueError(f"path: {target} exists; pass overwrite=True (--overwrite) to replace it")
     handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:
