@@ -25,7 +25,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from ._core import get_threads, set_threads
+from ._core import MomentumObserver, get_threads, set_threads
 from ._version import __version__
 
 # Imported here, not lazily: the submodule of the same name would otherwise shadow the function
@@ -95,10 +95,11 @@ _LAZY = {
     "scale_motion": ".time_scaling",
     "scale_torques": ".time_scaling",
     "scaling_for_torque_limits": ".time_scaling",
+    "observer": ".observer",
 }
 
-__all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",
-                  "__version__"])
+__all__ = sorted([*_LAZY, "BaseParameters", "MomentumObserver", "Robot", "base_parameters",
+                  "get_threads", "set_threads", "__version__"])
 
 
 def __getattr__(name: str) -> Any:
