@@ -111,15 +111,16 @@ def plot_residual(residual: Residual, path: str | Path, threshold: float | Array
     fig, axes = plt.subplots(n, 1, sharex=True, figsize=(8, 1.6 * n + 1), squeeze=False)
     limits = None if threshold is None else np.broadcast_to(real_array(threshold, "threshold"), (n,))
     for j, ax in enumerate(axes[:, 0]):
-        ax.plot(residual.t, residual.r[:, j], lw=0.8)
+        ax.plot(residual.t - residual.t[0], residual.r[:, j], lw=0.8)
         if limits is not None:
             for sign in (-1, 1):
                 ax.axhline(sign * limits[j], color="tab:red", lw=0.6, ls="--")
         ax.set_ylabel(f"r{j + 1}")
         ax.text(0.99, 0.9, f"RMS {residual.rms[j]:.3g}", transform=ax.transAxes, ha="right",
                 va="top", fontsize=8)
-    axes[-1, 0].set_xlabel("t [s]")
-    fig.suptitle(f"momentum-observer residual (gain {np.unique(residual.gain)} 1/s, dt {residual.dt:.4g} s)")
+    axes[-1, 0].set_xlabel("t - t0 [s]")
+    gains = ", ".join(f"{g:g}" for g in np.unique(residual.gain))
+    fig.suptitle(f"momentum-observer residual [N m] (gain {gains} 1/s, dt {residual.dt:.4g} s)")
     fig.tight_layout()
     out = Path(path)
     fig.savefig(out, dpi=120)

@@ -104,6 +104,26 @@ def export(args: argparse.Namespace) -> None:
     print(f"wrote {path}", flush=True)
 
 
+def residual(args: argparse.Namespace) -> None:
+    from ..io.log_files import load_log
+    from ..io.output_folder import check_output_path, output_folder
+    from ..io.result_files import load_model_or_result
+    from ..observer import plot_residual, residual_from_log, save_residual
+
+    check_output_path(args.output, args.overwrite)
+    model = load_model_or_result(args.model)
+    log = load_log(args.log, **log_options(args))
+    result = residual_from_log(model, log, args.gain)
+    with output_folder(args.output, args.overwrite) as staging:
+        save_residual(result, staging / "residual.npz")
+        plot_residual(result, staging / "residual.png", threshold=args.threshold)
+    print(f"momentum observer, gain {args.gain:g} 1/s, {log.T} samples at dt {result.dt:.4g} s")
+    print("  joint   rms [N m]   max |r| [N m]")
+    for j, (rms, largest) in enumerate(zip(result.rms, result.max_abs)):
+        print(f"  J{j + 1:<5}{rms:>11.4g}{largest:>16.4g}")
+    print(f"wrote {args.output}/residual.npz, {args.output}/residual.png", flush=True)
+
+
 def info(args: argparse.Namespace) -> None:
     from ..io.model_files import load_model
     from ..summary import model_summary

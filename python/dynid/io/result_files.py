@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from .._version import dynid_version
 from ..log_identification import LogIdentification, LogValidation
+from ..robot import Robot
 from .log_files import Log
 from .model_files import dumps_json, load_model, model_from_dict
 from .output_folder import output_folder
@@ -307,6 +308,15 @@ def _has_bool(value: Any) -> bool:
     return isinstance(value, list) and any(_has_bool(v) for v in value)
 
 
+def load_model_or_result(source: PathLike) -> Robot | LogIdentification:
+    """A result folder or ``result.json`` as a :class:`LogIdentification`, anything else as
+    :func:`~dynid.io.model_files.load_model` reads it (built-in name, model file, URDF)."""
+    path = Path(source)
+    if path.is_dir() or path.name == RESULT_FILE:
+        return load_result(path)
+    return load_model(source)
+
+
 def export_robot(
     source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
 ) -> Path:
@@ -314,16 +324,16 @@ def export_robot(
     folder or ``result.json`` of a physically consistent identification, or anything
     :func:`~dynid.io.model_files.load_model` reads (a built-in name, a model file, a URDF).
     A least-squares result holds base parameters only, not a robot: a ValueError says so."""
-    path = Path(source)
-    if path.is_dir() or path.name == RESULT_FILE:
-        result = load_result(path)
+    loaded = load_model_or_result(source)
+    if isinstance(loaded, LogIdentification):
+        result = loaded
         if result.physical is None:
             raise ValueError(
-                f"{path}: a least-squares result holds base parameters only, not a full robot; "
+                f"{source}: a least-squares result holds base parameters only, not a full robot; "
                 "identify with --physical (dynid identify LOG --physical) to export a model"
             )
         robot = result.robot
     else:
-        robot = load_model(source)
+        robot = loaded
     robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
     return Path(urdf)
