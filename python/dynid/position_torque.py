@@ -13,15 +13,16 @@ torque offset, the spring's rest position goes into the constant). A general onc
 function is ``offset + ks sin q + kc cos q``, hence the two columns here and the ``offset`` option
 for the constant.
 
-Identifiability. For some joints this function lies in the span of the rigid-body columns: e.g.
-the first joint with a horizontal axis after a vertical one (joint 2 of most arms), whose gravity
-torque from the links beyond is exactly a sin q_2 + b cos q_2 with constant a, b (the first moments
-of the subtree) at zero velocity, and identical up to velocity terms that the base parameters also
-carry. There the position torque is structurally indistinguishable from gravity, whatever the
-trajectory: adding it would let the unconstrained columns carry gravity and, in
-``physical_least_squares``, escape the mass constraints. :func:`position_torque_joints` keeps only
-the joints whose two columns raise the rank of the model's base regressor (with the drive terms and
-offsets asked for) by two at random states; the others are left out and said so.
+Identifiability. For some joints these two columns are combinations of the rigid-body columns
+for every motion, so a position torque there cannot be told apart from gravity: a pendulum
+across gravity (its torque holds g (c1 cos q + c2 sin q), c its first moments); joint 2 of
+``models.kuka_lwr4()`` and of most arms, whose frame-2 origin is fixed (on the vertical axis 1):
+link 2's first moments then enter the dynamics only through gravity, which is a sin q2 + b cos q2
+in row 2 alone. Adding the columns there would make the fit rank deficient and, in
+``physical_least_squares``, let unconstrained columns carry gravity past the mass constraints.
+:func:`position_torque_joints` keeps only the joints whose two columns raise the rank of the
+model's base regressor (with the drive terms and offsets asked for) by two at random states;
+the others are left out and said so.
 """
 
 from __future__ import annotations
