@@ -7,7 +7,8 @@ one way from the model to the files:
 - the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`, :mod:`dynid.urdf`
   (``Robot.from_urdf`` / ``Robot.to_urdf``);
 - its linear parametrisation: :mod:`~dynid.base_parameters`;
-- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (a virtual robot);
+- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (closed-loop
+  simulation, a virtual robot);
 - identification: :mod:`~dynid.identify` (least squares), :mod:`~dynid.from_controller` (the
   paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
   :mod:`~dynid.recursive`;
@@ -24,7 +25,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from ._core import get_threads, set_threads
+from ._core import MomentumObserver, get_threads, set_threads
 from ._version import __version__
 
 # Imported here, not lazily: the submodule of the same name would otherwise shadow the function
@@ -47,7 +48,7 @@ if TYPE_CHECKING:
     from .payload import PayloadEstimate, estimate_payload, payload_from_identified
     from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
-    from .sim import VirtualController
+    from .sim import VirtualController, simulate
     from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 #: Public name -> the module that defines it (imported on first access).
@@ -84,6 +85,7 @@ _LAZY = {
     "physical_least_squares": ".physical",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
+    "simulate": ".sim",
     "DynamicBounds": ".bounds",
     "dynamic_bounds": ".bounds",
     "PayloadEstimate": ".payload",
@@ -93,10 +95,11 @@ _LAZY = {
     "scale_motion": ".time_scaling",
     "scale_torques": ".time_scaling",
     "scaling_for_torque_limits": ".time_scaling",
+    "observer": ".observer",
 }
 
-__all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",
-                  "__version__"])
+__all__ = sorted([*_LAZY, "BaseParameters", "MomentumObserver", "Robot", "base_parameters",
+                  "get_threads", "set_threads", "__version__"])
 
 
 def __getattr__(name: str) -> Any:
