@@ -63,7 +63,8 @@ def identify(args: argparse.Namespace) -> None:
     result = identify_log(log, robot, rotor=args.rotor, friction=args.friction,
                           offset=args.offset, method=args.method,
                           preparation=preparation_options(args), physical=args.physical,
-                          prior=args.prior, prior_weight=args.prior_weight)
+                          prior=args.prior, prior_weight=args.prior_weight,
+                          position_torque=args.position_torque)
     new_notes = result.training["notes"][len(log.notes):]
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")

@@ -49,6 +49,10 @@ def _add_identify(subcommands: Any) -> None:
                    help="add viscous and Coulomb friction columns Fv, Fs")
     p.add_argument("--offset", action="store_true",
                    help="add a constant torque (sensor offset) per joint")
+    p.add_argument("--position-torque", action="store_true",
+                   help="add a torque ks_j sin q_j + kc_j cos q_j per joint (sensor/gear ripple "
+                   "once per turn, cable or spring stiffness), on the joints where it is "
+                   "distinguishable from gravity (docs/identification.md)")
     p.add_argument("--method", choices=("ols", "wls"), default="wls",
                    help="ordinary or weighted (per-joint noise) least squares (default wls)")
     p.add_argument("--physical", action="store_true",

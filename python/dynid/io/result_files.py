@@ -138,7 +138,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         "units": UNITS,
         "model": result.model,
         "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
-                    "method": result.method, "exclude_joints": list(result.excluded)},
+                    "method": result.method, "exclude_joints": list(result.excluded),
+                    "position_torque_joints": [j + 1 for j in result.position_joints]},
         "condition_number": _num(result.condition_number),
         "rank": result.rank,
         "coefficients": coefficients,
@@ -196,8 +197,9 @@ def result_from_dict(data: Any) -> LogIdentification:
     if beta.shape != (count, len(expected)):
         raise ValueError(f"base_parameters.beta: expected shape {(count, len(expected))}, "
                          f"got {beta.shape}")
+    position_joints = _position_joints(options.get("position_torque_joints", []), robot.n)
+    p = count + (robot.n if flags["offset"] else 0) + 2 * len(position_joints)
     rows = _get(data, "coefficients")
-    p = count + (robot.n if flags["offset"] else 0)
     if not isinstance(rows, list) or len(rows) != p:
         raise ValueError(f"coefficients: expected a list of {p} entries")
     records = [_object(row, f"coefficients[{k}]") for k, row in enumerate(rows)]
@@ -230,10 +232,21 @@ def result_from_dict(data: Any) -> LogIdentification:
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
-        covariance=_covariance(data.get("covariance"), count + (robot.n if flags["offset"] else 0)),
-        physical=physical,
+        covariance=_covariance(data.get("covariance"), p),
+        physical=physical, position_joints=position_joints,
         _robot=robot,
     )
+
+
+def _position_joints(value: Any, n: int) -> tuple[int, ...]:
+    """options.position_torque_joints (1-based, increasing; absent in older files: none) as
+    0-based joints."""
+    if not (isinstance(value, list) and all(isinstance(j, int) and not isinstance(j, bool)
+                                            for j in value)
+            and all(1 <= j <= n for j in value) and value == sorted(set(value))):
+        raise ValueError(f"options.position_torque_joints: expected increasing joint numbers "
+                         f"1..{n}, got {value!r}")
+    return tuple(j - 1 for j in value)
 
 
 def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
