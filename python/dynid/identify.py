@@ -105,7 +105,7 @@ def stack_by_joint(
     keep = [j for j in range(n) if j not in _excluded(exclude_joints, n)]
     A = Y3[:, keep, :].transpose(1, 0, 2).reshape(-1, p)
     b = tau2[:, keep].T.reshape(-1)
-    group = np.repeat(np.array(keep, dtype=np.int64), T)
+    group: NDArray[np.int64] = np.repeat(np.array(keep, dtype=np.int64), T)
     return np.ascontiguousarray(A), np.ascontiguousarray(b), group
 
 

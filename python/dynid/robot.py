@@ -9,6 +9,7 @@ the GIL released.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -251,11 +252,11 @@ class Robot(_core.Model):
         return low + (high - low) * rng.random((count, self.n))
 
 
-def _robot_from_state(state: dict[str, object]) -> Robot:
+def _robot_from_state(state: dict[str, Any]) -> Robot:
     """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
-    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],  # type: ignore[arg-type]
-                          state["gravity"], state["params"], state["base"], state["tool"],  # type: ignore[arg-type]
-                          state["qlim"], state["name"])  # type: ignore[arg-type]
+    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],
+                          state["gravity"], state["params"], state["base"], state["tool"],
+                          state["qlim"], state["name"])
     robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
     return robot
 

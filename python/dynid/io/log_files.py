@@ -196,7 +196,9 @@ def _check_finite(arr: NDArray, name: str, rows: NDArray | None = None) -> None:
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.nonzero(bad.reshape(len(arr), -1).any(axis=1))[0][0])
-        cols = np.nonzero(bad[i].ravel())[0] + 1 if arr.ndim == 2 else []
+        cols: NDArray[np.intp] | list[int] = (
+            np.nonzero(bad[i].ravel())[0] + 1 if arr.ndim == 2 else []
+        )
         joint = f", joint(s) {', '.join(str(c) for c in cols)}" if len(cols) else ""
         where = f"row {i}" if rows is None else f"line {rows[i]} (data row {i})"
         raise ValueError(f"{name}: non-finite value at {where}{joint}")
@@ -302,11 +304,12 @@ def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     with data:
         found = list(data.files)
         _check_npz_members(path)
+        arrays: dict[str, Any]
         if mapping is not None:
             arrays = _mapped_arrays(found, data.__getitem__, mapping)
             note = f"loaded from {path.name} (NPZ, columns {dict(mapping)})"
             return Log(**arrays, source=str(path), notes=[note])
-        arrays: dict[str, Any] = {}
+        arrays = {}
         flobaroid = False
         for name, aliases in NPZ_KEYS.items():
             present = [key for key in aliases if key in found]
@@ -413,6 +416,7 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
 def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     header, values, lines, notes = _read_csv_table(path)
     index = {name: c for c, name in enumerate(header)}
+    arrays: dict[str, Any]
     if mapping is not None:
         arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping)
         note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
@@ -427,7 +431,7 @@ def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     if not groups["q"]:
         raise ValueError(f"missing columns q1..qn; found columns: {', '.join(header)}")
     n = max(groups["q"])
-    arrays: dict[str, Any] = {"t": values[:, index["t"]]}
+    arrays = {"t": values[:, index["t"]]}
     for name, columns in groups.items():
         if not columns:
             if name == "tau":

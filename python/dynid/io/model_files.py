@@ -280,7 +280,8 @@ def _load_yaml(text: str, path: Path) -> Any:
     bytes of nested aliases (a "billion laughs" file) would otherwise expand to gigabytes."""
     yaml = _yaml(path)
 
-    class BoundedLoader(yaml.SafeLoader):  # type: ignore[name-defined,misc]
+    # yaml is a module object here (imported on demand), which mypy cannot use as a base class.
+    class BoundedLoader(yaml.SafeLoader):  # type: ignore[name-defined]
         aliases = 0
 
         def compose_node(self, parent: Any, index: Any) -> Any:

@@ -101,7 +101,7 @@ def prepare_log(
             )
     index = np.arange(log.T)  # original sample numbers of the rows still present
     fs = log.fs
-    spikes = np.zeros(log.T, dtype=bool)
+    spikes: NDArray[np.bool_] = np.zeros(log.T, dtype=bool)
     removals: list[tuple[NDArray[np.bool_], str]] = []  # (rows to drop, why), on the final grid
 
     # 1. spikes on the raw torque
@@ -163,7 +163,8 @@ def prepare_log(
             predicted = reference[index]
             what = "reference_tau (given)"
         else:
-            predicted = real_array(reference_tau(log), "reference_tau(log)")  # type: ignore[operator]
+            assert callable(reference_tau)  # not an array, so the function (checked above)
+            predicted = real_array(reference_tau(log), "reference_tau(log)")
             what = "reference_tau(log)"
             if predicted.shape != log.tau.shape:
                 raise ValueError(
