@@ -10,10 +10,11 @@ from __future__ import annotations
 import json
 import struct
 
-import dynid
-import dynid.cli
 import numpy as np
 import pytest
+
+import dynid
+import dynid.cli
 from dynid.demo import TIP_MASS, controller_model, run_demo
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

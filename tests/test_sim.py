@@ -9,9 +9,10 @@ from separate calls, the closed form of paper eq. (33) and finite differences.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from dynid.demo import controller_model
 from dynid.sim import VirtualController, paper_validation_trajectory

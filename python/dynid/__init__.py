@@ -77,8 +77,45 @@ _LAZY = {
     "VirtualController": ".sim",
 }
 
-__all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",
-                  "__version__"])
+# Literal (not computed) so that linters and type checkers see the public names; a test checks
+# that it lists every name of _LAZY.
+__all__ = [
+    "BaseParameters",
+    "FourierTrajectory",
+    "IdentifiedModel",
+    "LeastSquaresResult",
+    "Log",
+    "LogIdentification",
+    "RankDeficientError",
+    "RecursiveLeastSquares",
+    "Robot",
+    "VirtualController",
+    "__version__",
+    "base_parameters",
+    "excitation",
+    "get_cmake_dir",
+    "get_include",
+    "get_threads",
+    "identify_from_controller",
+    "identify_log",
+    "io",
+    "least_squares",
+    "load_log",
+    "load_model",
+    "load_result",
+    "models",
+    "optimize_excitation",
+    "payload_mass_estimates",
+    "prepare_log",
+    "save_log",
+    "save_model",
+    "save_result",
+    "set_threads",
+    "signal",
+    "sim",
+    "validate_log",
+    "validation",
+]
 
 
 def __getattr__(name: str) -> Any:

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from ._equality import ValueEquality
 from ._checks import real_array
+from ._equality import ValueEquality
 from .base_parameters import (
     BaseParameters,
     base_parameters,

@@ -13,9 +13,9 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
 4. the stacked system is solved by OLS or WLS (``dynid.identify.least_squares``).
 
 The result predicts torques on any log (``predict``), is checked on another log
-(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result` (JSON with everything needed
-to apply it again, including the model's DH table, plus PNG plots) and loaded back by
-:func:`dynid.load_result`.
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result`
+(JSON with everything needed to apply it again, including the model's DH table, plus PNG plots)
+and loaded back by :func:`dynid.load_result`.
 """
 
 from __future__ import annotations
@@ -49,7 +49,8 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 @dataclass(eq=False)
 class LogIdentification(ValueEquality):
-    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
+    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see
+    :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
     (``expressions`` gives each as a combination of the standard ones), then the offsets.
@@ -171,11 +172,11 @@ def identify_log(
     does not excite every base parameter.
     """
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if not isinstance(robot, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"robot: expected a dynid.Robot, got {type(robot).__name__}"
         )
     options = _options(preparation)
@@ -278,7 +279,7 @@ def _plain(value: Any) -> Any:
 
 def _with_derivatives(log: Log, n: int, name: str) -> Log:
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if log.n != n:

@@ -206,8 +206,8 @@ def puma560() -> Robot:
     ``Ia = Jm G^2``, ``Fv = B G^2`` and ``Fs = |G| (|Tc+| + |Tc-|) / 2``. The toolbox stores
     an asymmetric Coulomb friction ``Tc = [Tc+, Tc-]``, applied for positive and negative
     velocity respectively (its inline comment says "[-,+]", but the values and the toolbox's
-    own test torques fit [+, -]); dynid's Coulomb model ``Fs sign(qd)`` is symmetric, so the mean of the two
-    magnitudes is used. Zero ``Ia``, ``Fv``, ``Fs`` for the rigid-body arm alone.
+    own test torques fit [+, -]); dynid's Coulomb model ``Fs sign(qd)`` is symmetric, so the mean
+    of the two magnitudes is used. Zero ``Ia``, ``Fv``, ``Fs`` for the rigid-body arm alone.
 
     The published parameters are kept as they are, which makes
     ``robot.is_physically_consistent()`` False: link 1 has m = 0 (no mass was reported; it

@@ -50,7 +50,7 @@ def _array(x: ArrayLike, name: str, min_ndim: int = 1) -> NDArray[np.float64]:
 
 def _axis(x: NDArray, axis: int, name: str = "x") -> int:
     if not is_integer(axis):
-        raise ValueError(f"axis: expected an integer, got {axis!r}")  # noqa: TRY004
+        raise ValueError(f"axis: expected an integer, got {axis!r}")
     if not -x.ndim <= axis < x.ndim:
         raise ValueError(f"axis: {axis} is out of range for {name} with shape {x.shape}")
     return int(axis) % x.ndim
@@ -227,7 +227,8 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
     folding back onto low frequencies; the cutoff is relative, so arrays need no sampling rate.
     Pass ``antialias=False`` only for signals already band-limited below that (e.g. a log
     low-passed at a lower cutoff). A time vector must not be filtered: subsample
-    ``t[::factor]`` yourself, or decimate a whole log with :func:`dynid.io.preparation.decimate_log`.
+    ``t[::factor]`` yourself, or decimate a whole log with
+    :func:`dynid.io.preparation.decimate_log`.
     """
     if factor is None and len(data) >= 2 and is_integer(data[-1]):
         data, factor = data[:-1], data[-1]

@@ -222,10 +222,7 @@ def excitation_condition_number(
     _, q, qd, qdd = trajectory.sample(count)
     W = base.reduce(robot.regressor(q, qd, qdd, rotor=rotor, friction=friction))
     W = W.reshape(-1, base.count)
-    if scaled:
-        s = _scaled_singular_values(W)[2]
-    else:
-        s = np.linalg.svd(W, compute_uv=False)[::-1]
+    s = _scaled_singular_values(W)[2] if scaled else np.linalg.svd(W, compute_uv=False)[::-1]
     return float(s[-1] / s[0]) if s[0] > 0 else float("inf")
 
 
@@ -246,7 +243,8 @@ def _scaled_singular_values(W: NDArray[np.float64]) -> tuple[NDArray[np.float64]
 
 
 def _basis(t: NDArray[np.float64], wf: float, harmonics: int) -> tuple[NDArray[np.float64], ...]:
-    """(T, 2H) matrices mapping the coefficients [a_i | b_i] of a joint to q_i - q0_i, qd_i, qdd_i."""
+    """(T, 2H) matrices mapping the coefficients [a_i | b_i] of a joint to q_i - q0_i, qd_i and
+    qdd_i."""
     w = wf * np.arange(1, harmonics + 1)
     S, C = np.sin(np.outer(t, w)), np.cos(np.outer(t, w))
     return np.hstack([S / w, -C / w]), np.hstack([C, S]), np.hstack([-S * w, C * w])

@@ -68,7 +68,7 @@ def prepare_log(
     Sample removals come last because filters, derivatives and decimation need the uniform grid.
     """
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if differentiate not in ("missing", "always", "never"):

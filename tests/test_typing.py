@@ -1,0 +1,84 @@
+"""The installed package carries its types: py.typed, a _core.pyi stub that covers every name the
+compiled module exports (so editors and mypy see the C++ signatures), and a literal __all__."""
+
+from __future__ import annotations
+
+import ast
+import importlib.resources
+import inspect
+
+import dynid
+from dynid import _core
+
+
+def _installed_file(name: str) -> str:
+    return (importlib.resources.files("dynid") / name).read_text()
+
+
+def _stub() -> ast.Module:
+    return ast.parse(_installed_file("_core.pyi"))
+
+
+def _public(names: list[str]) -> set[str]:
+    return {n for n in names if not n.startswith("__")}
+
+
+def test_py_typed_is_installed() -> None:
+    assert _installed_file("py.typed") == ""
+
+
+def test_stub_lists_every_module_level_name_of_core() -> None:
+    module = _stub()
+    stubbed = {
+        node.name for node in module.body if isinstance(node, (ast.ClassDef, ast.FunctionDef))
+    }
+    compiled = {n for n in _public(dir(_core)) if callable(getattr(_core, n))}
+    assert compiled == stubbed, "regenerate python/dynid/_core.pyi: python tools/generate_stubs.py"
+
+
+def test_stub_lists_every_attribute_of_the_compiled_classes() -> None:
+    module = _stub()
+    classes = {node.name: node for node in module.body if isinstance(node, ast.ClassDef)}
+    base = _public(dir(object)) | {"_pybind11_conduit_v1_"}
+    for name, node in classes.items():
+        stubbed = {item.name for item in node.body if isinstance(item, ast.FunctionDef)}
+        compiled = set(vars(getattr(_core, name))) - base - {"__module__", "__doc__", "__dict__"}
+        compiled = {n for n in compiled if not n.startswith("__") or n in stubbed}
+        missing = compiled - stubbed
+        assert not missing, (
+            f"{name}: {sorted(missing)} not in _core.pyi; run tools/generate_stubs.py"
+        )
+
+
+def test_stub_arguments_match_the_binding_names() -> None:
+    # pybind11 puts the py::arg names in the first docstring line; the stub must use the same
+    # names so that keyword calls type-check.
+    module = _stub()
+    for node in ast.walk(module):
+        if not isinstance(node, ast.ClassDef):
+            continue
+        cls = getattr(_core, node.name)
+        for item in node.body:
+            if not isinstance(item, ast.FunctionDef) or item.decorator_list:
+                continue
+            doc = inspect.getdoc(getattr(cls, item.name)) or ""
+            first = doc.splitlines()[0] if doc else ""
+            if not first.startswith(item.name + "("):
+                continue  # e.g. __init__ (pybind11 writes "Overloaded function" or no line)
+            for arg in item.args.args[1:] + item.args.kwonlyargs:
+                assert f"{arg.arg}:" in first, (node.name, item.name, arg.arg, first)
+
+
+def test_all_is_literal_and_lists_every_lazy_name() -> None:
+    eager = {
+        "BaseParameters",
+        "Robot",
+        "base_parameters",
+        "get_threads",
+        "set_threads",
+        "__version__",
+    }
+    assert set(dynid.__all__) == set(dynid._LAZY) | eager
+    assert len(dynid.__all__) == len(set(dynid.__all__))
+    for name in dynid.__all__:
+        assert getattr(dynid, name) is not None
