@@ -79,12 +79,13 @@ class Robot(_core.Model):
         name
             A label for printing.
         """
+        expected = "dh: expected shape (n, 4) with rows [a, alpha, d, theta], got"
         try:
             shape = np.shape(dh)
         except ValueError:
-            shape = "a ragged sequence"
+            raise ValueError(f"{expected} a ragged sequence") from None
         if isinstance(dh, str) or len(shape) != 2:
-            raise ValueError(f"dh: expected shape (n, 4) with rows [a, alpha, d, theta], got {shape}")
+            raise ValueError(f"{expected} {shape}")
         n = shape[0]
         if joint_types is None:
             joint_types = "R" * n
@@ -167,7 +168,7 @@ class Robot(_core.Model):
         return names
 
     # ---- copies, pickling, equality (multiprocessing, Dask and Ray pickle what they send) -----
-    def _state(self) -> dict[str, object]:
+    def _state(self) -> dict[str, Any]:
         """Everything that defines the robot (derived caches such as base parameters excluded)."""
         return {
             "dh": self.dh, "joint_types": self.joint_types, "convention": self.convention,
@@ -176,7 +177,7 @@ class Robot(_core.Model):
             "Ia": self.Ia, "Fv": self.Fv, "Fs": self.Fs,
         }
 
-    def __reduce__(self) -> tuple[object, tuple[dict[str, object]]]:
+    def __reduce__(self) -> tuple[object, tuple[dict[str, Any]]]:
         return (_robot_from_state, (self._state(),))
 
     def __eq__(self, other: object) -> bool:

@@ -21,6 +21,7 @@ parameters (kg against kg m^2) rather than how well the motion excites them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -284,7 +285,12 @@ def _finite_array(value: ArrayLike, name: str) -> NDArray[np.float64]:
 
 
 def _finite_positive(value: object, name: str) -> float:
-    array = _finite_array(value, name) if not isinstance(value, bool) else np.array(np.nan)
+    # Any object goes to real_array, which raises the ValueError naming it for non-numbers.
+    array = (
+        _finite_array(cast(ArrayLike, value), name)
+        if not isinstance(value, bool)
+        else np.array(np.nan)
+    )
     if array.ndim != 0 or not array > 0.0:
         raise ValueError(f"{name}: expected a positive finite number, got {value!r}")
     return float(array)

@@ -107,7 +107,7 @@ def prepare_log(
     # 1. spikes on the raw torque
     if outlier_k is not None and reference_tau is None:
         flags, smoothed = sig.spike_mask(log.tau, fs, outlier_k)
-        spikes = flags.any(axis=1)
+        spikes = np.any(flags, axis=1)
         if spikes.any():
             log = log.replace(tau=np.where(flags, smoothed, log.tau))
 
@@ -130,7 +130,9 @@ def prepare_log(
     if differentiate != "never" and log.qd is None:
         new["qd"] = sig.differentiate(log.q, log.t)
     if differentiate != "never" and log.qdd is None:
-        new["qdd"] = sig.differentiate(new.get("qd", log.qd), log.t)
+        qd = new.get("qd", log.qd)
+        assert qd is not None  # measured, or differentiated just above
+        new["qdd"] = sig.differentiate(qd, log.t)
     if new:
         source = ("low-passed " if cutoff is not None else "") + ("q" if "qd" in new else "qd")
         note = (
@@ -171,8 +173,9 @@ def prepare_log(
                     f"reference_tau(log): expected shape {log.tau.shape}, got {predicted.shape}"
                 )
         spread = sig.MAD_TO_SIGMA * np.median(np.abs(log.tau - np.median(log.tau, axis=0)), axis=0)
-        flags = sig.outlier_mask(log.tau - predicted, outlier_k,
-                                 min_sigma=sig.SPIKE_FLOOR * spread).any(axis=1)
+        outliers = sig.outlier_mask(log.tau - predicted, outlier_k,
+                                    min_sigma=sig.SPIKE_FLOOR * spread)
+        flags = np.any(outliers, axis=1)
         why = (
             f"whose torque deviates from {what} by more than {outlier_k:g} robust sigmas "
             "(median/MAD per joint)"
@@ -183,7 +186,7 @@ def prepare_log(
     if min_velocity is not None and log.qd is not None:
         moving = sig.moving_mask_min_velocity(log.qd, min_velocity)
         why = (
-            f"with |qd| < {np.round(min_velocity, 6)} on some joint (friction sign ill-defined "
+            f"with |qd| < {np.round(np.asarray(min_velocity), 6)} on some joint (friction sign ill-defined "
             "near zero velocity)"
         )
         removals.append((~moving, why))
