@@ -189,7 +189,8 @@ class Robot(_core.Model):
         return all(np.array_equal(mine[k], theirs[k]) if isinstance(mine[k], np.ndarray)
                    else mine[k] == theirs[k] for k in mine)
 
-    __hash__ = None  # type: ignore[assignment]  # parameters are settable
+    # Unhashable (parameters are settable); mypy objects to None in place of the inherited method.
+    __hash__ = None  # type: ignore[assignment]
 
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""

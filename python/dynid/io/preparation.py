@@ -186,8 +186,8 @@ def prepare_log(
     if min_velocity is not None and log.qd is not None:
         moving = sig.moving_mask_min_velocity(log.qd, min_velocity)
         why = (
-            f"with |qd| < {np.round(np.asarray(min_velocity), 6)} on some joint (friction sign ill-defined "
-            "near zero velocity)"
+            f"with |qd| < {np.round(np.asarray(min_velocity), 6)} on some joint (friction sign "
+            "ill-defined near zero velocity)"
         )
         removals.append((~moving, why))
 
