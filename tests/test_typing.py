@@ -69,6 +69,66 @@ def test_stub_arguments_match_the_binding_names() -> None:
                 assert f"{arg.arg}:" in first, (node.name, item.name, arg.arg, first)
 
 
+def _bound_functions() -> list[tuple[str, object]]:
+    found: list[tuple[str, object]] = []
+    for name, value in vars(_core).items():
+        if inspect.isbuiltin(value):
+            found.append((name, value))
+        elif isinstance(value, type) and value.__module__ == _core.__name__:
+            found += [
+                (f"{name}.{attr}", member)
+                for attr, member in vars(value).items()
+                if type(member).__name__ == "instancemethod"
+            ]
+    return found
+
+
+def _docstring_parameters(doc: str) -> list[tuple[str, object]]:
+    """(name, default) from pybind11's typed first docstring line, e.g. "f(self: M, q: object,
+    rotor: object = False) -> numpy.ndarray"; `inspect.Parameter.empty` when there is none."""
+    head = doc.splitlines()[0]
+    inner = head[head.index("(") + 1 : head.rindex(") -> ")]
+    tree = ast.parse(f"def f({inner}): pass").body[0]
+    assert isinstance(tree, ast.FunctionDef)
+    args = tree.args
+    positional = args.args
+    defaults = [inspect.Parameter.empty] * (len(positional) - len(args.defaults)) + [
+        ast.literal_eval(d) for d in args.defaults
+    ]
+    kw_defaults = [
+        inspect.Parameter.empty if d is None else ast.literal_eval(d) for d in args.kw_defaults
+    ]
+    return [(a.arg, d) for a, d in zip(positional, defaults)] + [
+        (a.arg, d) for a, d in zip(args.kwonlyargs, kw_defaults)
+    ]
+
+
+def test_inspect_signature_shows_the_parameters_of_the_cpp_calls() -> None:
+    assert list(inspect.signature(dynid.Robot.rnea).parameters) == ["self", "q", "qd", "qdd"]
+    robot = dynid.models.planar_2r()
+    assert list(inspect.signature(robot.rnea).parameters) == ["q", "qd", "qdd"]
+    signature = inspect.signature(robot.regressor)
+    assert signature.parameters["rotor"].default is False
+    assert list(inspect.signature(dynid.set_threads).parameters) == ["threads"]
+    rls = inspect.signature(dynid.RecursiveLeastSquares)
+    assert rls.parameters["theta0"].kind is inspect.Parameter.KEYWORD_ONLY
+    # __doc__ keeps pybind11's typed signature line (what pybind11-stubgen and help() read)
+    assert (dynid.Robot.rnea.__doc__ or "").startswith("rnea(self: dynid._core.Model, q: object")
+
+
+def test_every_text_signature_matches_the_pybind11_docstring() -> None:
+    # Independent source: the typed signature line pybind11 writes itself, parsed with ast.
+    functions = _bound_functions()
+    assert len(functions) > 30
+    for name, function in functions:
+        doc = function.__doc__ or ""
+        if not doc.startswith(name.split(".")[-1] + "(") or "Overloaded function" in doc:
+            continue  # pybind11 internals (_pybind11_conduit_v1_) and overloads
+        expected = _docstring_parameters(doc)
+        got = [(p.name, p.default) for p in inspect.signature(function).parameters.values()]
+        assert got == expected, name
+
+
 def test_all_is_literal_and_lists_every_lazy_name() -> None:
     eager = {
         "BaseParameters",

@@ -19,11 +19,14 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import inspect
 import re
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 STUB = ROOT / "python" / "dynid" / "_core.pyi"
@@ -180,14 +183,29 @@ def polish(text: str) -> tuple[str, list[str]]:
     return polished.replace(marker, HEADER + marker, 1), unknown
 
 
+def _no_text_signature(getfullargspec: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    """getfullargspec that refuses the bound functions, as it did before _core gave them a
+    __text_signature__ (cpp/bindings/text_signatures.cpp): pybind11-stubgen then reads the typed
+    signature pybind11 writes into the docstring instead of the untyped text signature."""
+
+    def refuse_builtins(func: Any) -> Any:
+        if getattr(func, "__text_signature__", None) is not None:
+            raise TypeError("a builtin: read the pybind11 docstring")
+        return getfullargspec(func)
+
+    return refuse_builtins
+
+
 def run_stubgen() -> str:
+    import pybind11_stubgen
+
     with tempfile.TemporaryDirectory() as tmp:
-        # Run outside the source tree so that the installed package (with _core) is imported.
-        subprocess.run(
-            [sys.executable, "-m", "pybind11_stubgen", MODULE, "-o", tmp, "--exit-code"],
-            cwd=tmp,
-            check=True,
-        )
+        original = inspect.getfullargspec
+        inspect.getfullargspec = _no_text_signature(original)
+        try:
+            pybind11_stubgen.main([MODULE, "-o", tmp, "--exit-code"])
+        finally:
+            inspect.getfullargspec = original
         return (Path(tmp) / (MODULE.replace(".", "/") + ".pyi")).read_text()
 
 
