@@ -350,3 +350,14 @@ def test_import_dynid_loads_no_plotting_or_optimisers() -> None:
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=True).stdout.strip()
     assert loaded == ""
+
+
+def test_load_model_reads_builtin_names_and_urdf() -> None:
+    """The CLI's --model: the new built-in names and a URDF path give the models of
+    dynid.models / Robot.from_urdf (exact: the same construction)."""
+    from dynid.io.model_files import load_model
+
+    assert load_model("panda") == dynid.models.panda()
+    assert load_model("ur5") == dynid.models.ur5()
+    urdf = "tests/data/urdf/kuka_lwr4.urdf"
+    assert load_model(urdf) == dynid.Robot.from_urdf(urdf)

@@ -66,6 +66,16 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     "forgetting": "float",
     "max_variance": "float",
     "memo": "dict[int, typing.Any]",
+    # closed-loop simulation (dynid.sim.simulate checks and passes these)
+    "q0": ARRAY_LIKE,
+    "qd0": ARRAY_LIKE,
+    ("_simulate", "model"): "Model | None",
+    ("_simulate", "kp"): f"{ARRAY_LIKE} | None",
+    ("_simulate", "kd"): f"{ARRAY_LIKE} | None",
+    ("_simulate", "q_d"): f"{ARRAY_LIKE} | None",
+    ("_simulate", "qd_d"): f"{ARRAY_LIKE} | None",
+    ("_simulate", "qdd_d"): f"{ARRAY_LIKE} | None",
+    ("_simulate", "function"): (f"typing.Callable[[float, {ARRAY}, {ARRAY}], {ARRAY_LIKE}] | None"),
 }
 
 # Property setters (their single argument is unnamed in pybind11), by property name.
@@ -85,6 +95,12 @@ SETTER_TYPES: dict[str, str] = {
 RETURN_TYPES: dict[str | tuple[str, ...], str] = {
     "kinetic_energy": f"float | {ARRAY}",
     "potential_energy": f"float | {ARRAY}",
+}
+
+# Functions whose pybind11 return annotation contains typing.Any (a py::object element).
+RETURN_REPLACEMENTS: dict[str, tuple[str, str]] = {
+    # q, qd, qdd, tau and the measured q (None unless recorded)
+    "_simulate": ("typing.Any]", f"{ARRAY} | None]"),
 }
 
 DEF = re.compile(
@@ -168,6 +184,10 @@ def polish(text: str) -> tuple[str, list[str]]:
                 type_parameter(p, cls, func, setter, unknown) for p in split_top_level(m["params"])
             ]
             ret = m["ret"].replace("numpy.ndarray", ARRAY)
+            if func in RETURN_REPLACEMENTS:
+                ret = ret.replace(*RETURN_REPLACEMENTS[func])
+            if "typing.Any" in ret and ret != "typing.Any":
+                unknown.append(f"return value of {cls + '.' if cls else ''}{func} ({ret})")
             if ret == "typing.Any":
                 new = lookup(RETURN_TYPES, cls, func, func)
                 if new is None:

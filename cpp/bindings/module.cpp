@@ -5,6 +5,7 @@
 
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
+#include "simulator.hpp"
 #include "text_signatures.hpp"
 
 namespace py = pybind11;
@@ -13,6 +14,7 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
   dynid::binding::bind_recursive_least_squares(m);
+  dynid::binding::bind_simulator(m);
   m.def(
       "standard_parameters",
       [](double mass, py::handle com, py::handle inertia_com) {

@@ -4,13 +4,16 @@ The C++ core (``dynid._core``) computes kinematics, inverse and forward dynamics
 and Coriolis matrices and the regressors; this package holds the user's workflow on top of it,
 one way from the model to the files:
 
-- the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`;
+- the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`, :mod:`dynid.urdf`
+  (``Robot.from_urdf`` / ``Robot.to_urdf``);
 - its linear parametrisation: :mod:`~dynid.base_parameters`;
-- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (a virtual robot);
+- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (closed-loop
+  simulation, a virtual robot);
 - identification: :mod:`~dynid.identify` (least squares), :mod:`~dynid.from_controller` (the
   paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
   :mod:`~dynid.recursive`;
 - checking the result: :mod:`~dynid.validation`, :mod:`~dynid.plots`;
+- uses of the model: :mod:`~dynid.time_scaling`, :mod:`~dynid.bounds`, :mod:`~dynid.payload`;
 - files: :mod:`dynid.io` (model and result files); the command line: :mod:`dynid.cli`.
 
 Names are loaded on first use (PEP 562), so ``import dynid`` stays fast: SciPy's optimisers and
@@ -32,6 +35,7 @@ from .robot import Robot
 
 if TYPE_CHECKING:
     from . import models
+    from .bounds import DynamicBounds, dynamic_bounds
     from .cmake import get_cmake_dir, get_include
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
@@ -41,8 +45,11 @@ if TYPE_CHECKING:
     from .io.preparation import prepare_log
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
+    from .payload import PayloadEstimate, estimate_payload, payload_from_identified
+    from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
-    from .sim import VirtualController
+    from .sim import VirtualController, simulate
+    from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 #: Public name -> the module that defines it (imported on first access).
 _LAZY = {
@@ -73,25 +80,44 @@ _LAZY = {
     "LogIdentification": ".log_identification",
     "identify_log": ".log_identification",
     "validate_log": ".log_identification",
+    "PhysicalIdentificationError": ".physical",
+    "PhysicalResult": ".physical",
+    "physical_least_squares": ".physical",
     "RecursiveLeastSquares": ".recursive",
     "VirtualController": ".sim",
+    "simulate": ".sim",
+    "DynamicBounds": ".bounds",
+    "dynamic_bounds": ".bounds",
+    "PayloadEstimate": ".payload",
+    "estimate_payload": ".payload",
+    "payload_from_identified": ".payload",
+    "scale_time": ".time_scaling",
+    "scale_motion": ".time_scaling",
+    "scale_torques": ".time_scaling",
+    "scaling_for_torque_limits": ".time_scaling",
 }
 
 # Literal (not computed) so that linters and type checkers see the public names; a test checks
 # that it lists every name of _LAZY.
 __all__ = [
     "BaseParameters",
+    "DynamicBounds",
     "FourierTrajectory",
     "IdentifiedModel",
     "LeastSquaresResult",
     "Log",
     "LogIdentification",
+    "PayloadEstimate",
+    "PhysicalIdentificationError",
+    "PhysicalResult",
     "RankDeficientError",
     "RecursiveLeastSquares",
     "Robot",
     "VirtualController",
     "__version__",
     "base_parameters",
+    "dynamic_bounds",
+    "estimate_payload",
     "excitation",
     "get_cmake_dir",
     "get_include",
@@ -105,14 +131,21 @@ __all__ = [
     "load_result",
     "models",
     "optimize_excitation",
+    "payload_from_identified",
     "payload_mass_estimates",
+    "physical_least_squares",
     "prepare_log",
     "save_log",
     "save_model",
     "save_result",
+    "scale_motion",
+    "scale_time",
+    "scale_torques",
+    "scaling_for_torque_limits",
     "set_threads",
     "signal",
     "sim",
+    "simulate",
     "validate_log",
     "validation",
 ]

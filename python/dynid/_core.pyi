@@ -279,6 +279,43 @@ def _last_batch_threads() -> int:
     Threads the last batch call ran on.
     """
 
+def _simulate(
+    plant: Model,
+    q0: numpy.typing.ArrayLike,
+    qd0: numpy.typing.ArrayLike,
+    periods: typing.SupportsInt | typing.SupportsIndex,
+    dt: typing.SupportsFloat | typing.SupportsIndex,
+    substeps: typing.SupportsInt | typing.SupportsIndex,
+    method: str,
+    friction: bool,
+    coulomb_band: typing.SupportsFloat | typing.SupportsIndex,
+    torque_noise: typing.SupportsFloat | typing.SupportsIndex,
+    encoder_counts: typing.SupportsFloat | typing.SupportsIndex,
+    seed: typing.SupportsInt | typing.SupportsIndex,
+    kind: str,
+    model: Model | None,
+    kp: numpy.typing.ArrayLike | None,
+    kd: numpy.typing.ArrayLike | None,
+    q_d: numpy.typing.ArrayLike | None,
+    qd_d: numpy.typing.ArrayLike | None,
+    qdd_d: numpy.typing.ArrayLike | None,
+    function: typing.Callable[
+        [float, numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]],
+        numpy.typing.ArrayLike,
+    ]
+    | None,
+    record_measured: bool,
+) -> tuple[
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64] | None,
+]:
+    """
+    Closed-loop simulation (use dynid.sim.simulate): returns q, qd, qdd, tau and the measured q (or None), each (periods + 1, n).
+    """
+
 def get_threads() -> int:
     """
     Threads used by batch calls.

@@ -9,6 +9,7 @@ the GIL released.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -99,6 +100,57 @@ class Robot(_core.Model):
         if name:
             robot.name = name
         return robot
+
+    @classmethod
+    def from_urdf(
+        cls,
+        urdf: str | Path,
+        base_link: str | None = None,
+        tip_link: str | None = None,
+        convention: str = "standard",
+        gravity: ArrayLike = (0.0, 0.0, -9.81),
+    ) -> Robot:
+        """Build a robot from the serial chain of a URDF (SPEC 6; docs/urdf.md).
+
+        ``urdf`` is a path or the XML text. The chain runs from ``base_link`` (default: the root
+        link) to ``tip_link`` (default: the single leaf reached through movable joints). Its
+        revolute, continuous and prismatic joints are the n joints and **q is the URDF joint
+        position** (same zero, same sign); fixed joints are merged. The DH table (``convention``)
+        has z along each joint axis, theta/d offsets, and base and tool transforms such that
+        ``fkine(q)`` is the pose of ``tip_link`` in ``base_link``'s frame (the world). Inertials
+        become standard parameters in the DH frames, ``<limit>`` goes to ``qlim`` (continuous
+        joints: (-pi, pi)), ``<dynamics damping friction>`` to ``Fv`` and ``Fs``.
+
+        ValueError (naming the joint, link or argument) for malformed XML, a branched tree
+        without ``tip_link``, floating, planar or mimic joints on the chain, a moving link
+        without any inertial, an axis of zero length.
+        """
+        from .urdf import dh_model_from_urdf  # on first use: import dynid stays fast
+
+        model = dh_model_from_urdf(urdf, base_link, tip_link, convention)
+        robot = cls.from_dh(model.dh, model.joint_types, convention, gravity, model.params,
+                            model.base, model.tool, model.qlim, model.name)
+        robot.Ia, robot.Fv, robot.Fs = model.Ia, model.Fv, model.Fs
+        return robot
+
+    def to_urdf(
+        self, name: str = "robot", path: str | Path | None = None, overwrite: bool = False
+    ) -> str:
+        """The robot as URDF text (SPEC 6; docs/urdf.md); with ``path`` also written there
+        (atomically; an existing file only with ``overwrite=True``).
+
+        One URDF link per DH link with its inertial about the centre of mass, joints with axis
+        z, ``qlim`` as limits, Fv and Fs as ``<dynamics damping friction>``, the base and tool
+        transforms as fixed placements, and Ia (no URDF field) as a ``dynid: Ia`` comment that
+        :meth:`from_urdf` reads back. ValueError naming the first link that is not physically
+        consistent.
+        """
+        from .urdf import urdf_text, write_urdf  # on first use: import dynid stays fast
+
+        text = urdf_text(self, name)
+        if path is not None:
+            write_urdf(text, path, overwrite)
+        return text
 
     # ---- limits and labels -------------------------------------------------------------------
     @property

@@ -52,6 +52,8 @@ def identify(args: argparse.Namespace) -> None:
     from ..log_identification import identify_log
 
     check_output_path(args.output, args.overwrite)  # before the work, not after
+    if not args.physical and (args.prior is not None or args.prior_weight is not None):
+        raise ValueError("--prior, --prior-weight: only with --physical")
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
     step(f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
@@ -60,7 +62,8 @@ def identify(args: argparse.Namespace) -> None:
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
     result = identify_log(log, robot, rotor=args.rotor, friction=args.friction,
                           offset=args.offset, method=args.method,
-                          preparation=preparation_options(args))
+                          preparation=preparation_options(args), physical=args.physical,
+                          prior=args.prior, prior_weight=args.prior_weight)
     new_notes = result.training["notes"][len(log.notes):]
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
@@ -92,6 +95,13 @@ def validate(args: argparse.Namespace) -> None:
     path = save_validation(validation, args.output, result_source=str(args.result),
                            log_source=str(args.log), overwrite=args.overwrite)
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def export(args: argparse.Namespace) -> None:
+    from ..io.result_files import export_robot
+
+    path = export_robot(args.source, args.urdf, name=args.name, overwrite=args.overwrite)
+    print(f"wrote {path}", flush=True)
 
 
 def info(args: argparse.Namespace) -> None:

@@ -8,6 +8,7 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
+from ..physical import PhysicalIdentificationError
 from .parsers import build_parser
 
 #: Exit status for bad input (missing file, malformed log, model or result), as argparse's.
@@ -28,7 +29,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"dynid {args.command}: interrupted", file=sys.stderr)
         return 130
-    except (ValueError, OSError, OverflowError, MemoryError, RecursionError) as exc:
+    except (ValueError, OSError, OverflowError, MemoryError, RecursionError,
+            PhysicalIdentificationError) as exc:
         # A user error (a file, a field, a value): one line naming it, never a traceback.
         # RecursionError: absurdly deep nesting in a JSON/YAML file; MemoryError: a file
         # asking for more than the machine has.

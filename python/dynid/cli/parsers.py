@@ -28,6 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_identify(subcommands)
     _add_validate(subcommands)
     _add_info(subcommands)
+    _add_export(subcommands)
     return parser
 
 
@@ -49,6 +50,14 @@ def _add_identify(subcommands: Any) -> None:
                    help="add a constant torque (sensor offset) per joint")
     p.add_argument("--method", choices=("ols", "wls"), default="wls",
                    help="ordinary or weighted (per-joint noise) least squares (default wls)")
+    p.add_argument("--physical", action="store_true",
+                   help="physically consistent fit (SDP: every link a possible rigid body, "
+                   "Ia, Fv, Fs >= 0); the result holds a full robot (docs/identification.md)")
+    p.add_argument("--prior", metavar="MODEL|URDF",
+                   help="with --physical: the model (built-in name, model file or URDF) whose "
+                   "parameters fill the directions the data cannot see")
+    p.add_argument("--prior-weight", type=float, metavar="W",
+                   help="with --prior: its weight (default 1e-5, docs/identification.md)")
     _add_preparation(p)
     p.add_argument("--min-velocity", type=float, metavar="V",
                    help="drop samples where some joint has |qd| < V (friction near zero speed)")
@@ -85,10 +94,24 @@ def _add_info(subcommands: Any) -> None:
     p.set_defaults(run=commands.info)
 
 
+def _add_export(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "export", help="write a model or a physically consistent result as URDF",
+        description="Write the robot of SOURCE as a URDF: SOURCE is a result folder (or its "
+        "result.json) of `dynid identify --physical`, a built-in model name, a model file or a "
+        "URDF. Least-squares results hold base parameters only and cannot be exported.",
+    )
+    p.add_argument("source", metavar="SOURCE", help="result folder/result.json, model or URDF")
+    p.add_argument("--urdf", required=True, metavar="FILE", help="the URDF file to write")
+    p.add_argument("--name", help="robot name in the URDF (default: the model's name)")
+    p.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
+    p.set_defaults(run=commands.export)
+
+
 def _add_model(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default=DEFAULT_MODEL, metavar="NAME|FILE",
-                   help="built-in model (kuka_lwr4, puma560, planar_2r) or a model file, JSON "
-                   f"or YAML (docs/cli.md); default {DEFAULT_MODEL}")
+                   help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
+                   f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}")
 
 
 def _add_preparation(p: argparse.ArgumentParser) -> None:

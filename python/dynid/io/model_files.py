@@ -35,6 +35,9 @@ BUILTIN_MODELS: dict[str, Callable[[], Robot]] = {
     "kuka_lwr4": models.kuka_lwr4,
     "puma560": models.puma560,
     "planar_2r": models.planar_2r,
+    "panda": models.panda,
+    "ur5": models.ur5,
+    "ur10": models.ur10,
 }
 
 FORMAT = "dynid-model"
@@ -59,7 +62,9 @@ MAX_EXPANDED_VALUES = 1_000_000
 
 
 def load_model(path_or_name: PathLike) -> Robot:
-    """A built-in model (``kuka_lwr4``, ``puma560``, ``planar_2r``) or a model file (JSON/YAML).
+    """A built-in model (``kuka_lwr4``, ``puma560``, ``planar_2r``, ``panda``, ``ur5``,
+    ``ur10``), a model file (JSON/YAML) or a URDF file (``.urdf``: :meth:`Robot.from_urdf` with
+    its defaults: the whole chain from the root to the single leaf, standard DH).
 
     Raises FileNotFoundError for a missing file and ValueError naming the field that is missing
     or malformed (prefixed by the file name).
@@ -76,6 +81,10 @@ def load_model(path_or_name: PathLike) -> Robot:
             )
         raise FileNotFoundError(f"model: no such file: {path}")
     try:
+        if path.suffix.lower() == ".urdf":
+            if path.stat().st_size > MAX_FILE_BYTES:
+                raise ValueError(f"more than {MAX_FILE_BYTES} bytes: not a robot description")
+            return Robot.from_urdf(path)
         return model_from_dict(read_structured(path))
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None

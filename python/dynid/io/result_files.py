@@ -5,7 +5,9 @@ the model (DH table, joint types, convention, gravity, base/tool, limits), the r
 the base-parameter structure (independent columns and beta over the standard parameter names),
 the coefficients with their expressions and standard deviations, the condition number and rank,
 and the training log's preparation and per-joint fit. Non-finite numbers (a relative standard
-deviation of a coefficient that is exactly 0) are written as null.
+deviation of a coefficient that is exactly 0) are written as null. A physically consistent
+result (``identify_log(physical=True)``) also holds the identified parameters in ``model`` and
+the solver's report in ``physical``; ``load_result(...).robot`` is then the identified robot.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from numpy.typing import NDArray
 from .._version import dynid_version
 from ..log_identification import LogIdentification, LogValidation
 from .log_files import Log
-from .model_files import dumps_json, model_from_dict
+from .model_files import dumps_json, load_model, model_from_dict
 from .output_folder import output_folder
 
 PathLike = Union[str, Path]
@@ -128,7 +130,7 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     ]
     training = dict(result.training)
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
-    return {
+    data = {
         "format": FORMAT,
         "version": VERSION,
         "dynid_version": dynid_version(),
@@ -148,6 +150,9 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
             "beta": _nums(result.beta),
         },
     }
+    if result.physical is not None:
+        data["physical"] = result.physical
+    return data
 
 
 def result_from_dict(data: Any) -> LogIdentification:
@@ -204,6 +209,12 @@ def result_from_dict(data: Any) -> LogIdentification:
     training["metrics"] = {k: _array(v, f"training.metrics.{k}", 1, nullable=True)
                            for k, v in metrics.items()}
     method = _get(options, "method", "options")
+    physical = data.get("physical")
+    if physical is not None:
+        physical = _object(physical, "physical")
+        if not robot.is_physically_consistent():
+            raise ValueError("model: a physically consistent result whose parameters are not "
+                             "physically consistent (edited file?)")
     return LogIdentification(
         model=dict(model), rotor=flags["rotor"], friction=flags["friction"],
         offset=flags["offset"], method=str(method), parameter_names=list(names_std),
@@ -219,6 +230,7 @@ def result_from_dict(data: Any) -> LogIdentification:
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
         covariance=_covariance(data.get("covariance"), count + (robot.n if flags["offset"] else 0)),
+        physical=physical,
         _robot=robot,
     )
 
@@ -293,3 +305,25 @@ def _has_bool(value: Any) -> bool:
     if isinstance(value, bool):
         return True
     return isinstance(value, list) and any(_has_bool(v) for v in value)
+
+
+def export_robot(
+    source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
+) -> Path:
+    """Write the robot of ``source`` as a URDF file (``dynid export``): ``source`` is a result
+    folder or ``result.json`` of a physically consistent identification, or anything
+    :func:`~dynid.io.model_files.load_model` reads (a built-in name, a model file, a URDF).
+    A least-squares result holds base parameters only, not a robot: a ValueError says so."""
+    path = Path(source)
+    if path.is_dir() or path.name == RESULT_FILE:
+        result = load_result(path)
+        if result.physical is None:
+            raise ValueError(
+                f"{path}: a least-squares result holds base parameters only, not a full robot; "
+                "identify with --physical (dynid identify LOG --physical) to export a model"
+            )
+        robot = result.robot
+    else:
+        robot = load_model(source)
+    robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
+    return Path(urdf)
