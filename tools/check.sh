@@ -28,7 +28,7 @@ PY
   rm -f "$requirements"
 fi
 
-targets=(python tests bench tools)
+targets=(python tests bench tools examples)
 failed=()
 step() {  # step NAME COMMAND...: run every check, report all failures at the end
   local name=$1

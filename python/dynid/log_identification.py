@@ -271,6 +271,7 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
               prior: Robot | None, prior_weight: float, source: Any) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one."""
     robot, n = result.robot, result.n
+    assert log.qd is not None and log.qdd is not None  # the prepared log (_with_derivatives)
     Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
     if Y.ndim == 2:
         Y = Y[None]

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from importlib.resources import files
+from pathlib import Path
 
 import numpy as np
 
@@ -338,5 +339,6 @@ def _ur(file: str, name: str, convention: str) -> Robot:
     return robot
 
 
-def _data_file(name: str):
-    return files("dynid").joinpath("data", name)
+def _data_file(name: str) -> Path:
+    # A path (the package is installed as files): np.loadtxt and read_text take it directly.
+    return Path(str(files("dynid") / "data" / name))
