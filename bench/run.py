@@ -38,6 +38,7 @@ TARGETS: dict[tuple[str, str], tuple[str, float]] = {
     ("C++", "coriolis_matrix"): ("ratio", 0.5),
     ("C++", "regressor"): ("ratio", 0.5),
     ("C++", "forward_dynamics"): ("ratio", 1.0),
+    ("C++", "rnea_derivatives"): ("ratio", 0.7),  # issue 11
     ("Python", "rnea"): ("ratio", 1.0),
     ("Python", "mass_matrix"): ("ratio", 1.0),
     ("Python", "gravity"): ("ratio", 1.0),
@@ -51,6 +52,7 @@ PINOCCHIO_NAMES = {
     ("C++", "coriolis_matrix"): "computeCoriolisMatrix",
     ("C++", "regressor"): "computeJointTorqueRegressor",
     ("C++", "forward_dynamics"): "aba",
+    ("C++", "rnea_derivatives"): "computeRNEADerivatives",
     ("Python", "rnea"): "pin.rnea",
     ("Python", "mass_matrix"): "pin.crba",
     ("Python", "gravity"): "pin.computeGeneralizedGravity",

@@ -85,6 +85,7 @@ def _robot() -> dynid.Robot:
         (lambda: dynid.identify_from_controller("robot", np.zeros((3, 7)), np.zeros((3, 7)),
                                                 np.zeros((3, 7, 7))), "structure"),
         (lambda: dynid.base_parameters("robot"), "robot"),
+        (lambda: dynid.VirtualController("x"), "robot"),
         (lambda: dynid.base_parameters(_robot(), "torque", rotor="no"), "rotor"),
         (lambda: setattr(_robot(), "qlim", [[10**400, 1]] * 7), "qlim"),
         (lambda: io.Log(np.arange(5.0), np.zeros((5, 2)), np.zeros((5, 2))).select([7]), "mask"),

@@ -66,6 +66,9 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     "forgetting": "float",
     "max_variance": "float",
     "memo": "dict[int, typing.Any]",
+    # momentum observer
+    ("MomentumObserver", "__init__", "gain"): f"float | {ARRAY_LIKE}",
+    ("MomentumObserver", "__init__", "dt"): "float",
     # closed-loop simulation (dynid.sim.simulate checks and passes these)
     "q0": ARRAY_LIKE,
     "qd0": ARRAY_LIKE,

@@ -7,12 +7,14 @@
 #include "recursive_least_squares.hpp"
 #include "simulator.hpp"
 #include "text_signatures.hpp"
+#include "uses.hpp"
 
 namespace py = pybind11;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
+  dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
   m.def(

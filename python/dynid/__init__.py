@@ -25,7 +25,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from ._core import get_threads, set_threads
+from ._core import MomentumObserver, get_threads, set_threads
 from ._version import __version__
 
 # Imported here, not lazily: the submodule of the same name would otherwise shadow the function
@@ -95,6 +95,7 @@ _LAZY = {
     "scale_motion": ".time_scaling",
     "scale_torques": ".time_scaling",
     "scaling_for_torque_limits": ".time_scaling",
+    "observer": ".observer",
 }
 
 # Literal (not computed) so that linters and type checkers see the public names; a test checks
@@ -107,6 +108,7 @@ __all__ = [
     "LeastSquaresResult",
     "Log",
     "LogIdentification",
+    "MomentumObserver",
     "PayloadEstimate",
     "PhysicalIdentificationError",
     "PhysicalResult",
@@ -130,6 +132,7 @@ __all__ = [
     "load_model",
     "load_result",
     "models",
+    "observer",
     "optimize_excitation",
     "payload_from_identified",
     "payload_mass_estimates",

@@ -14,6 +14,7 @@ import numpy.typing
 
 __all__: list[str] = [
     "Model",
+    "MomentumObserver",
     "RecursiveLeastSquares",
     "get_threads",
     "physical_inconsistency",
@@ -86,6 +87,12 @@ class Model:
         """
         Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].
         """
+    def jacobian_dot(
+        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike
+    ) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Time derivative (6, n) of jacobian(q) along qd: tool point, world axes, rows [v; omega].
+        """
     def kinetic_energy(
         self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike
     ) -> float | numpy.typing.NDArray[numpy.float64]:
@@ -118,6 +125,12 @@ class Model:
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).
+        """
+    def rnea_derivatives(
+        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike
+    ) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+        """
+        Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, n, n) each for T samples (Carpentier & Mansard 2018); dtau_dqd includes diag(Fv), dtau/dqdd is mass_matrix(q). Both are views into one (2, n, n) or (T, 2, n, n) array.
         """
     @property
     def Fs(self) -> numpy.typing.NDArray[numpy.float64]:
@@ -182,6 +195,54 @@ class Model:
         """
     @tool.setter
     def tool(self, arg1: numpy.typing.ArrayLike) -> None: ...
+
+class MomentumObserver:
+    """
+    Generalized-momentum collision residual (De Luca & Mattone 2005):
+    r = K_O (p(t) - p(0) - int (tau + S^T qd - g - F(qd) + r) dt), p = M(q) qd.
+
+    r tracks the external joint torque J^T F_ext through a first-order filter of time constant
+    1 / gain and stays zero (to the model and integration error) without contact. Discretised with
+    the trapezoidal rule, r implicit (Tustin). The robot's model is copied at construction.
+
+    Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample period, s).
+    """
+    def __init__(self, robot: Model, gain: float | numpy.typing.ArrayLike, dt: float) -> None: ...
+    def reset(self) -> None:
+        """
+        Forget the history: the next sample starts a new integral (r = 0, p(0) = M q̇).
+        """
+    def run(
+        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike
+    ) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        The residual (T, n) over a log (T, n) each, sample by sample in C++ with the GIL released, continuing from the current state (call reset() first for a new log).
+        """
+    def update(
+        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike
+    ) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        One sample (n,) each of measured q, qd and motor torque tau: the residual r (n,).
+        """
+    @property
+    def dt(self) -> float: ...
+    @property
+    def gain(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        K_O per joint (n,), 1/s.
+        """
+    @property
+    def n(self) -> int: ...
+    @property
+    def residual(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        The last residual r (n,).
+        """
+    @property
+    def samples(self) -> int:
+        """
+        Samples seen since construction or reset().
+        """
 
 class RecursiveLeastSquares:
     """

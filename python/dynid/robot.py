@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from . import _core
+from . import _core, linearization, operational_space
 
 PARAMETER_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
 
@@ -27,7 +27,8 @@ class Robot(_core.Model):
     Build one with :meth:`Robot.from_dh` or take one from :mod:`dynid.models`. The dynamics
     methods (``rnea``, ``mass_matrix``, ``gravity``, ``coriolis``, ``coriolis_matrix``,
     ``friction``, ``forward_dynamics``, ``kinetic_energy``, ``potential_energy``, ``fkine``,
-    ``jacobian``) accept one sample (n,) or T samples (T, n).
+    ``jacobian``, and SPEC section 8's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
+    ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
     """
 
     def __init__(
@@ -297,6 +298,30 @@ class Robot(_core.Model):
         other = self.copy()
         other.Ia = other.Fv = other.Fs = np.zeros(self.n)
         return other
+
+    # ---- uses of the model (SPEC section 8) ---------------------------------------------------
+    def linearize(
+        self, q: ArrayLike, qd: ArrayLike | None = None, qdd: ArrayLike | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(A, B) of the dynamics linearized at (q, qd, qdd), x = (q, qd), u = tau (notes
+        p. 44-47): (2n, 2n), (2n, n), or (T, 2n, 2n), (T, 2n, n). qd, qdd default to zeros (an
+        equilibrium). See :mod:`dynid.linearization`."""
+        return linearization.linearize(self, q, qd, qdd)
+
+    def cartesian_inertia(
+        self, q: ArrayLike, rows: str | Sequence[int] | None = None
+    ) -> NDArray[np.float64]:
+        """Operational-space inertia (J M^-1 J^T)^-1 of the tool point, (6, 6) or (T, 6, 6);
+        ``rows`` selects task rows ("position", "orientation" or indices). ValueError naming
+        ``q`` at a singular configuration. See :mod:`dynid.operational_space`."""
+        return operational_space.cartesian_inertia(self, q, rows)
+
+    def cartesian_dynamics(
+        self, q: ArrayLike, qd: ArrayLike, rows: str | Sequence[int] | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(Lam, mu, p) with Lam xdd + mu + p = F, xdd = J qdd + Jdot qd (Khatib):
+        mu = Lam (J M^-1 c - Jdot qd), p = Lam J M^-1 g. See :mod:`dynid.operational_space`."""
+        return operational_space.cartesian_dynamics(self, q, qd, rows)
 
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
