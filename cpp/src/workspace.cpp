@@ -26,6 +26,7 @@ WorkspaceBuffers::WorkspaceBuffers(int joints)
       zeros(VectorX::Zero(n)),
       M(MatrixX::Zero(n, n)),
       bias(VectorX::Zero(n)),
-      cholesky(n) {}
+      cholesky(n),
+      derivatives(n) {}
 
 }  // namespace dynid::detail

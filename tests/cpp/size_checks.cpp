@@ -183,6 +183,18 @@ int main() {
   expect_rejected("RecursiveLeastSquares", "theta0", [&] { rls.reset(VectorX::Zero(3), MatrixX::Identity(4, 4)); }, false);
   expect_rejected("RecursiveLeastSquares", "P0", [&] { rls.reset(VectorX::Zero(4), MatrixX::Identity(3, 3)); }, false);
 
+  MatrixX Jdot(6, n), Jdot_wrong(6, n - 1), dtau_dq(n, n), dtau_dqd(n, n);
+  expect_rejected("jacobian_dot", "ws", [&] { dynid::jacobian_dot(model, ws_other, q, qd, Jdot); });
+  expect_rejected("jacobian_dot", "q", [&] { dynid::jacobian_dot(model, ws, short_vector, qd, Jdot); });
+  expect_rejected("jacobian_dot", "qd", [&] { dynid::jacobian_dot(model, ws, q, long_vector, Jdot); });
+  expect_rejected("jacobian_dot", "Jdot", [&] { dynid::jacobian_dot(model, ws, q, qd, Jdot_wrong); });
+  expect_rejected("rnea_derivatives", "ws", [&] { dynid::rnea_derivatives(model, ws_other, q, qd, qdd, dtau_dq, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "q", [&] { dynid::rnea_derivatives(model, ws, long_vector, qd, qdd, dtau_dq, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "qd", [&] { dynid::rnea_derivatives(model, ws, q, short_vector, qdd, dtau_dq, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "qdd", [&] { dynid::rnea_derivatives(model, ws, q, qd, short_vector, dtau_dq, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "dtau_dq", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, wrong_rows, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "dtau_dqd", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, dtau_dq, wrong_square); });
+
   dynid::Simulator simulator(model, dynid::SimulationSettings{});
   expect_rejected("Simulator::acceleration", "q", [&] { simulator.acceleration(short_vector, qd, tau, qdd_out); });
   expect_rejected("Simulator::acceleration", "qd", [&] { simulator.acceleration(q, long_vector, tau, qdd_out); });

@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <vector>
 
+#include "dynid/detail/derivative_buffers.hpp"
 #include "dynid/detail/joint_transform.hpp"
 #include "dynid/rigid_body.hpp"
 #include "dynid/types.hpp"
@@ -58,6 +59,9 @@ struct WorkspaceBuffers {
   MatrixX M;
   VectorX bias;
   Eigen::LLT<MatrixX> cholesky;
+
+  // Analytic derivatives (rnea_derivatives.cpp).
+  DerivativeBuffers derivatives;
 };
 
 }  // namespace dynid::detail
