@@ -2,6 +2,8 @@
 // per-sample dynamics calls (single sample or a batch looped in C++).
 #include "model.hpp"
 
+#include "batch.hpp"
+
 #include <atomic>
 #include <cctype>
 #include <stdexcept>
@@ -230,6 +232,11 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q, py::handle qd, py::handle qdd) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
+            if (use_lanes(self, s))
+              return evaluate_lanes(self, s, {n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                     const double* const* in, double* out, long T) {
+                return k.rnea(bm, in[0], in[1], in[2], out, T);
+              });
             return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutVec tau(out, n);
               rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
@@ -242,6 +249,11 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
+            if (use_lanes(self, s))
+              return evaluate_lanes(self, s, {n, n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                        const double* const* in, double* out, long T) {
+                return k.mass_matrix(bm, in[0], out, T);
+              });
             return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutMat M = row_major(out, n, n);
               crba(m, ws, ConstVec(in[0], n), M);
@@ -253,6 +265,11 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
+            if (use_lanes(self, s))
+              return evaluate_lanes(self, s, {n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                     const double* const* in, double* out, long T) {
+                return k.gravity(bm, in[0], out, T);
+              });
             return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutVec g(out, n);
               gravity(m, ws, ConstVec(in[0], n), g);

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "batch.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 
@@ -11,6 +12,7 @@ namespace py = pybind11;
 PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
+  dynid::binding::bind_batch(m);
   dynid::binding::bind_recursive_least_squares(m);
   m.def(
       "standard_parameters",

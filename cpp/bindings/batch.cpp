@@ -1,0 +1,33 @@
+// Python access to the batch path selection (tests run every path the CPU supports).
+#include "batch.hpp"
+
+namespace dynid::binding {
+
+void bind_batch(py::module_& m) {
+  m.def(
+      "_batch_isa", [] { return detail::batch_isa(); },
+      "The path batch calls of rnea, gravity and mass_matrix run on: 'scalar' (the per-sample "
+      "kernels), 'sse2', 'avx2' or 'avx512' (SIMD lanes across samples).");
+  m.def(
+      "_set_batch_isa",
+      [](const std::string& isa) {
+        try {
+          detail::set_batch_isa(isa);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("isa"),
+      "Force a batch path (for tests); also DYNID_BATCH_ISA at import. ValueError when the CPU "
+      "cannot run it.");
+  m.def(
+      "_supported_batch_isas",
+      [] {
+        py::list names;
+        for (const std::string& name : detail::supported_batch_isas()) names.append(name);
+        return names;
+      },
+      "The batch paths this CPU and build can run.");
+}
+
+}  // namespace dynid::binding
