@@ -21,11 +21,13 @@ from .recursive import RecursiveLeastSquares
 from .result_files import load_result
 from .robot import Robot
 from .sim import VirtualController
+from .streaming import LeastSquaresAccumulator, least_squares_streaming
 
 __all__ = [
     "BaseParameters",
     "FourierTrajectory",
     "IdentifiedModel",
+    "LeastSquaresAccumulator",
     "LeastSquaresResult",
     "Log",
     "LogIdentification",
@@ -40,6 +42,7 @@ __all__ = [
     "identify_from_controller",
     "identify_log",
     "least_squares",
+    "least_squares_streaming",
     "load_log",
     "load_model",
     "load_result",
