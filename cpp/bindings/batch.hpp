@@ -23,12 +23,12 @@ inline bool use_lanes(const PyModel& self, const Samples& s) {
 // the first non-finite sample relative to `begin`, or -1.
 template <class Kernel>
 py::array evaluate_lanes(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail,
-                         Kernel kernel) {
+                         Kernel kernel, py::handle out_arg) {
   const int n = self.model->n();
   py::ssize_t per_sample = 1;
   for (py::ssize_t d : tail) per_sample *= d;
   tail.insert(tail.begin(), s.count);
-  py::array_t<double> out(tail);
+  py::array_t<double> out = output_array(out_arg, tail);
   double* out_data = out.mutable_data();
   std::shared_ptr<const Model> model = self.model;
   std::vector<detail::BatchJoint> joints;

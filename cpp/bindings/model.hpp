@@ -52,56 +52,67 @@ constexpr py::ssize_t kMinSamplesPerThread = 512;
 
 // Runs kernel(model, workspace, inputs, output) on one sample, or on each of T samples in C++
 // with the GIL released, split over batch_threads() threads each with its own Workspace; the
-// output has shape `tail` or (T, *tail).
+// output has shape `tail` or (T, *tail) and is `out` when given (output_array). Each sample's
+// output is checked for finiteness right after it is written, while it is in cache.
 template <class Kernel>
-py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail, Kernel kernel) {
+py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail, Kernel kernel,
+                   py::handle out_arg = py::none()) {
   const int n = self.model->n();
   py::ssize_t per_sample = 1;
   for (py::ssize_t d : tail) per_sample *= d;
   if (!s.single) tail.insert(tail.begin(), s.count);
-  py::array_t<double> out(tail);
+  py::array_t<double> out = output_array(out_arg, tail);
   double* out_data = out.mutable_data();
   const std::size_t arguments = s.size;
   if (s.single) {
     const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
     for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
-    require_finite_result(out_data, per_sample, s.names.c_str());
+    if (!all_finite(out_data, per_sample)) require_finite_result(out_data, per_sample, s.names.c_str());
     return out;
   }
   std::shared_ptr<const Model> model = self.model;
-  auto run = [&](py::ssize_t begin, py::ssize_t end) {
+  const py::ssize_t threads = std::max<py::ssize_t>(
+      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
+  std::vector<py::ssize_t> first_bad(threads, -1);
+  auto run = [&](py::ssize_t part) {
+    const py::ssize_t begin = s.count * part / threads, end = s.count * (part + 1) / threads;
     Workspace ws(*model);
     const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
     for (py::ssize_t t = begin; t < end; ++t) {
       for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
-      kernel(*model, ws, in, out_data + t * per_sample);
+      double* sample = out_data + t * per_sample;
+      kernel(*model, ws, in, sample);
+      if (!all_finite(sample, per_sample)) {
+        first_bad[part] = t;
+        return;
+      }
     }
   };
-  const py::ssize_t threads = std::max<py::ssize_t>(
-      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
-  py::gil_scoped_release release;
-  last_batch_threads = static_cast<int>(threads);
-  if (threads == 1) {
-    run(0, s.count);
-    require_finite_result(out_data, s.count * per_sample, s.names.c_str());
-    return out;
-  }
-  std::vector<std::thread> pool;
-  std::vector<std::exception_ptr> errors(threads);
-  for (py::ssize_t k = 0; k < threads; ++k) {
-    pool.emplace_back([&, k] {
-      try {
-        run(s.count * k / threads, s.count * (k + 1) / threads);
-      } catch (...) {
-        errors[k] = std::current_exception();
+  {
+    py::gil_scoped_release release;
+    last_batch_threads = static_cast<int>(threads);
+    if (threads == 1) {
+      run(0);
+    } else {
+      std::vector<std::thread> pool;
+      std::vector<std::exception_ptr> errors(threads);
+      for (py::ssize_t k = 0; k < threads; ++k) {
+        pool.emplace_back([&, k] {
+          try {
+            run(k);
+          } catch (...) {
+            errors[k] = std::current_exception();
+          }
+        });
       }
-    });
+      for (std::thread& worker : pool) worker.join();
+      for (const std::exception_ptr& error : errors)
+        if (error) std::rethrow_exception(error);
+    }
   }
-  for (std::thread& worker : pool) worker.join();
-  for (const std::exception_ptr& error : errors)
-    if (error) std::rethrow_exception(error);
-  require_finite_result(out_data, s.count * per_sample, s.names.c_str());
+  for (py::ssize_t t : first_bad)
+    if (t >= 0) require_finite_result(out_data + t * per_sample, per_sample, s.names.c_str());
   return out;
 }
 

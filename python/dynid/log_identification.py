@@ -10,7 +10,8 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
    (``dynid.base_parameters``);
 3. optionally one constant column per joint is appended: a torque offset (sensor bias; with
    Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-);
-4. the stacked system is solved by OLS or WLS (``dynid.identify.least_squares``).
+4. the stacked system is solved by OLS or WLS (``dynid.streaming``: the regressor chunk by
+   chunk into triangular factors, the solver of ``dynid.identify.least_squares``).
 
 The result predicts torques on any log (``predict``), is checked on another log
 (:func:`validate_log`) and is saved to a folder (JSON with everything needed to apply it again,
@@ -28,16 +29,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .base_parameters import base_parameters
-from .identify import least_squares
 from .io import Log, prepare_log
 from .model_files import model_from_dict, model_to_dict
 from .robot import Robot
+from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
 
 PathLike = Union[str, Path]
 
 #: Name of the torque-offset coefficient of joint j (1-based): "off1", "off2", ...
 OFFSET_NAME = "off"
+
+#: Samples per regressor chunk folded into the least-squares factors.
+STREAM_CHUNK = 8192
 
 #: The options of dynid.io.prepare_log that ``preparation`` may hold.
 PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "outlier_k",
@@ -95,15 +99,19 @@ class LogIdentification:
 
     def regressor(self, q: Any, qd: Any, qdd: Any) -> NDArray[np.float64]:
         """The (T, n, p) regressor of ``theta``: base columns, then the offset columns."""
-        Y = self.robot.regressor(q, qd, qdd, rotor=self.rotor, friction=self.friction)
-        if Y.ndim == 2:
-            Y = Y[None]
-        if Y.shape[-1] != len(self.parameter_names):
+        robot = self.robot
+        total = robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
+        if total != len(self.parameter_names):
             raise ValueError(
-                f"model: its regressor has {Y.shape[-1]} columns, the result expects "
+                f"model: its regressor has {total} columns, the result expects "
                 f"{len(self.parameter_names)}"
             )
-        Y = Y[..., self.independent]
+        # Only the base columns, selected in C++ (no full (T, n, P) array).
+        Y = robot.regressor(
+            q, qd, qdd, rotor=self.rotor, friction=self.friction, columns=self.independent
+        )
+        if Y.ndim == 2:
+            Y = Y[None]
         if self.offset:
             ones = np.broadcast_to(np.eye(self.n), (Y.shape[0], self.n, self.n))
             Y = np.concatenate([Y, ones], axis=2)
@@ -196,8 +204,18 @@ def identify_log(
         relative_std=np.zeros(len(names)), condition_number=np.nan, rank=0, log=prepared,
         _robot=robot,
     )
-    Y = result.regressor(prepared.q, prepared.qd, prepared.qdd)
-    fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints)
+    # The regressor chunk by chunk into the triangular factors (dynid.streaming): memory bounded
+    # by a chunk whatever the log's length; a second pass predicts the torques for the metrics.
+    chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
+    accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
+    for c in chunks:
+        accumulator.add(result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]),
+                        prepared.tau[c])
+    fit = accumulator.solve(method=method, names=names)
+    predicted = np.concatenate(
+        [result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]) @ fit.theta
+         for c in chunks]
+    )
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.excluded = fit.excluded
@@ -210,7 +228,7 @@ def identify_log(
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
         "notes": list(prepared.notes),
-        "metrics": error_metrics(prepared.tau, Y @ fit.theta),
+        "metrics": error_metrics(prepared.tau, predicted),
     }
     return result
 

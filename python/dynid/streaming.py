@@ -110,6 +110,7 @@ def least_squares_streaming(
         )
     index = _columns(columns, robot, rotor, friction)
     accumulator: LeastSquaresAccumulator | None = None
+    buffer: NDArray[np.float64] | None = None  # reused while chunks have the same length
     for k, chunk in enumerate(chunks):
         try:
             q, qd, qdd, tau = chunk
@@ -118,9 +119,14 @@ def least_squares_streaming(
                 f"chunks: expected (q, qd, qdd, tau) tuples, got {type(chunk).__name__} "
                 f"as chunk {k}"
             ) from None
-        Y = robot.regressor(q, qd, qdd, rotor=rotor, friction=friction)
-        if index is not None:
-            Y = Y[..., index]
+        count = np.shape(q)[0] if np.ndim(q) == 2 else None
+        width = index.size if index is not None else 10 * robot.n + (robot.n if rotor else 0) + (
+            2 * robot.n if friction else 0)
+        shape = (count, robot.n, width)
+        if count is not None and (buffer is None or buffer.shape != shape):
+            buffer = np.empty(shape)
+        Y = robot.regressor(q, qd, qdd, rotor=rotor, friction=friction, columns=index,
+                            out=buffer if count is not None else None)
         if accumulator is None:
             accumulator = LeastSquaresAccumulator(
                 robot.n, Y.shape[-1], exclude_joints=exclude_joints
