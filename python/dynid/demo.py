@@ -22,6 +22,7 @@ import numpy as np
 
 from . import models, plots
 from ._checks import count
+from ._threads import blas_single_threaded
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .robot import Robot
 from .signal import differentiate, lowpass
@@ -64,6 +65,7 @@ def controller_model() -> Robot:
     return robot
 
 
+@blas_single_threaded  # small dense work throughout (_threads.py)
 def run_demo(
     output: str | Path = "dynid-demo",
     train: int = 1000,

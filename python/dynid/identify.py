@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._checks import real_array
 from ._qr import GroupedTriangularFactors, solve_triangular_system
+from ._threads import blas_single_threaded
 
 METHODS = ("ols", "wls")
 ON_RANK_DEFICIENT = ("raise", "warn")
@@ -108,6 +109,7 @@ def stack_by_joint(
     return np.ascontiguousarray(A), np.ascontiguousarray(b), group
 
 
+@blas_single_threaded  # QR blocks of ~1000 x p: faster on one thread (_threads.py)
 def least_squares(
     Y: ArrayLike,
     tau: ArrayLike,

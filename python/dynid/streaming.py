@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._qr import GroupedTriangularFactors
+from ._threads import blas_single_threaded
 from .identify import (
     LeastSquaresResult,
     _check_options,
@@ -52,6 +53,7 @@ class LeastSquaresAccumulator:
         """Samples added so far."""
         return self._factors.samples
 
+    @blas_single_threaded
     def add(self, Y: ArrayLike, tau: ArrayLike) -> None:
         """Adds T samples: Y (T, n, p) or (n, p) for one, tau (T, n) or (n,); finite values."""
         Y3, tau2 = _samples(Y, tau)
@@ -62,6 +64,7 @@ class LeastSquaresAccumulator:
             )
         self._factors.add(Y3, tau2)
 
+    @blas_single_threaded
     def solve(
         self,
         *,
@@ -83,6 +86,7 @@ class LeastSquaresAccumulator:
         )
 
 
+@blas_single_threaded
 def least_squares_streaming(
     robot: Robot,
     chunks: Iterable[tuple[Any, Any, Any, Any]],
