@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "batch.hpp"
+#include "fast_calls.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 
@@ -13,6 +14,7 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
   dynid::binding::bind_batch(m);
+  dynid::binding::bind_fast_calls(m);
   dynid::binding::bind_recursive_least_squares(m);
   m.def(
       "standard_parameters",

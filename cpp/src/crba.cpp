@@ -62,9 +62,11 @@ void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B) {
   for (int i = 1; i <= n; ++i) ws.composite[i] = from_body(model.body(i - 1));
   for (int i = n; i >= 2; --i) add_to_parent(ws.X[i], ws.composite[i], ws.composite[i - 1]);
 
+  // Column i of B starts as the wrench of composite i for a unit acceleration of joint i ...
   for (int i = 1; i <= n; ++i) {
     const Composite& C = ws.composite[i];
-    Vector3 f, mu;  // wrench about the origin of J_i for a unit acceleration along z
+    Vector3& f = ws.f[i];
+    Vector3& mu = ws.mu[i];  // about the origin of J_i
     if (model.joint(i - 1).revolute) {
       mu = Vector3(C.I[2], C.I[4], C.I[5]);  // I e_z
       f = Vector3(-C.h.y(), C.h.x(), 0.0);   // z x h
@@ -73,11 +75,19 @@ void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B) {
       f = Vector3(0.0, 0.0, C.m);
     }
     B(i - 1, i - 1) = model.joint(i - 1).revolute ? mu.z() : f.z();
-    for (int j = i - 1; j >= 1; --j) {
-      const JointTransform& X = ws.X[j + 1];
+  }
+  // ... and is carried inwards frame by frame. Every column that has reached J_{j+1} crosses
+  // X[j+1] in the same sweep: the columns' chains are independent, so interleaving them keeps
+  // the floating-point units busy instead of waiting on one chain's latency.
+  for (int j = n - 1; j >= 1; --j) {
+    const JointTransform& X = ws.X[j + 1];
+    const bool revolute = model.joint(j - 1).revolute;
+    for (int i = j + 1; i <= n; ++i) {
+      Vector3& f = ws.f[i];
+      Vector3& mu = ws.mu[i];
       f = X.rotate_to_parent(f);
       mu = X.rotate_to_parent(mu) + X.p.cross(f);
-      const double bji = model.joint(j - 1).revolute ? mu.z() : f.z();
+      const double bji = revolute ? mu.z() : f.z();
       B(j - 1, i - 1) = bji;
       B(i - 1, j - 1) = bji;
     }

@@ -24,7 +24,7 @@ struct Workspace {
   // Newton-Euler recursion, all in the joint frames J_i: angular velocity and acceleration,
   // linear velocity and acceleration of the frame origin, force and moment (about the origin)
   // that link i-1 exerts on link i.
-  std::vector<Vector3> omega, omegad, v, a, f, mu;
+  std::vector<Vector3> omega, omegad, v, a, f, mu;  // CRBA reuses f, mu for its columns
 
   // World poses of the joint frames (rotation, origin).
   std::vector<Matrix3> R_world;
