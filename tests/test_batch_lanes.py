@@ -1,7 +1,7 @@
 """The SIMD batch kernels (samples in vector lanes, one translation unit per instruction set,
 chosen at load time) against the scalar reference kernels, on every path this CPU can run.
 
-A batch of T samples on a lane path must equal T single calls (which always run the scalar
+A batch of T samples on a lane path (rnea, gravity, mass matrix, regressor) must equal T single calls (which always run the scalar
 kernels, themselves tested against Pinocchio and closed forms elsewhere) to 1e-12 relative to
 the sample's largest entry (at least 1): the lane kernels do the same arithmetic, in another
 order only where FMA contracts it, and compute sin/cos with their own reduction and polynomial.
@@ -66,6 +66,16 @@ def test_lanes_equal_single_calls_for_every_batch_size(lane_path: str, case: str
     assert_same(robot.rnea(q, qd, qdd), per_sample(robot.rnea, q, qd, qdd))
     assert_same(robot.gravity(q), per_sample(robot.gravity, q))
     assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
+    for rotor, friction in ((False, False), (True, True)):
+        assert_same(
+            robot.regressor(q, qd, qdd, rotor=rotor, friction=friction),
+            per_sample(lambda *x: robot.regressor(*x, rotor=rotor, friction=friction), q, qd, qdd),
+        )
+    columns = np.array([5, 0, 3 * robot.n, 10 * robot.n + 2, 10 * robot.n + 2])
+    assert_same(
+        robot.regressor(q, qd, qdd, rotor=True, friction=True, columns=columns),
+        per_sample(lambda *x: robot.regressor(*x, rotor=True, friction=True)[:, columns], q, qd, qdd),
+    )
 
 
 @pytest.mark.parametrize("q_scale", [1e3, 1e4, 1e5, 3e6])
@@ -78,6 +88,8 @@ def test_lanes_large_joint_angles(lane_path: str, case: str, q_scale: float) -> 
     q, qd, qdd = states(arm, 37, seed=7, q_scale=q_scale)
     q[::3] /= q_scale
     assert_same(robot.rnea(q, qd, qdd), per_sample(robot.rnea, q, qd, qdd))
+    assert_same(robot.regressor(q, qd, qdd, friction=True),
+                per_sample(lambda *x: robot.regressor(*x, friction=True), q, qd, qdd))
     assert_same(robot.gravity(q), per_sample(robot.gravity, q))
     assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
 
@@ -117,6 +129,8 @@ def test_lanes_report_overflow_by_name(lane_path: str) -> None:
     qd[13, 2] = 1e200
     with pytest.raises(ValueError, match="q, qd, qdd: the result overflowed"):
         robot.rnea(q, qd, qdd)
+    with pytest.raises(ValueError, match="q, qd, qdd: the result overflowed"):
+        robot.regressor(q, qd, qdd, columns=[0, 61, 65])  # link 7: w^2 overflows
     params = np.array(robot.params)
     params[3:6, 9] = 1e308  # Izz: their sum in the composite inertia overflows
     robot.params = params

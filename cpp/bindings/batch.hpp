@@ -14,9 +14,9 @@
 namespace dynid::binding {
 
 // True when a batch of `s` should use the lane kernels.
-inline bool use_lanes(const PyModel& self, const Samples& s) {
+inline bool use_lanes(const PyModel& self, const Samples& s, int max_joints = detail::kMaxBatchJoints) {
   return !s.single && s.count > 0 && detail::batch_kernels() != nullptr &&
-         self.model->n() <= detail::kMaxBatchJoints;
+         self.model->n() <= max_joints;
 }
 
 // kernel(kernels, batch_model, inputs (each at sample `begin`), output at `begin`, count) returns

@@ -376,6 +376,15 @@ void bind_model(py::module_& m) {
             const int n = self.model->n();
             const int P = regressor_columns(n, rotor, friction);
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
+            const std::vector<int> columns =
+                columns_arg.is_none() ? std::vector<int>() : parse_columns(columns_arg, P);
+            const int C = columns.empty() ? P : static_cast<int>(columns.size());
+            if (use_lanes(self, s, detail::kMaxRegressorLaneJoints))
+              return evaluate_lanes(self, s, {n, C}, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                         const double* const* in, double* out, long T) {
+                return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
+                                   columns.empty() ? nullptr : columns.data(), C, out, T);
+              }, out);
             if (columns_arg.is_none())
               return evaluate(self, s, {n, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
                 RowMajorMap Y(out, n, P);
@@ -383,8 +392,6 @@ void bind_model(py::module_& m) {
               }, out);
             // Only the selected columns (e.g. the base parameters'): each sample's full regressor
             // goes to a per-thread buffer in cache and the columns are copied out of it.
-            const std::vector<int> columns = parse_columns(columns_arg, P);
-            const int C = static_cast<int>(columns.size());
             return evaluate(self, s, {n, C}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
               thread_local std::vector<double> full;
               full.resize(static_cast<std::size_t>(n) * P);

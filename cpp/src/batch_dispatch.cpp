@@ -90,6 +90,11 @@ BatchModel batch_model(const Model& model, std::vector<BatchJoint>& joints) {
                            {b.I(0, 0), b.I(0, 1), b.I(0, 2), b.I(1, 1), b.I(1, 2), b.I(2, 2)},
                            model.rotor_inertia()[i], model.viscous_friction()[i],
                            model.coulomb_friction()[i]};
+    const LinkOffset& o = model.link_offset(i);
+    joints[i].offset_identity = o.identity ? 1 : 0;
+    joints[i].offset_cos_alpha = o.cos_alpha;
+    joints[i].offset_sin_alpha = o.sin_alpha;
+    joints[i].offset_a = o.a;
   }
   const Vector3 g = -model.gravity_base();
   return BatchModel{n, joints.data(), {g.x(), g.y(), g.z()}};

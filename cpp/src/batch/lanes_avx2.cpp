@@ -3,8 +3,10 @@
 #define DYNID_LANES 4
 #define DYNID_LANES_NS lanes_avx2_impl
 #include "lane_kernels.hpp"
+#include "lane_regressor.hpp"
 
 namespace dynid::detail {
 const LaneKernels lanes_avx2 = {"avx2", 4, &lanes_avx2_impl::rnea, &lanes_avx2_impl::gravity,
-                                &lanes_avx2_impl::mass_matrix};
+                                &lanes_avx2_impl::mass_matrix,
+                                &lanes_avx2_impl::regressor};
 }  // namespace dynid::detail

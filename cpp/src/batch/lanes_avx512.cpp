@@ -3,8 +3,10 @@
 #define DYNID_LANES 8
 #define DYNID_LANES_NS lanes_avx512_impl
 #include "lane_kernels.hpp"
+#include "lane_regressor.hpp"
 
 namespace dynid::detail {
 const LaneKernels lanes_avx512 = {"avx512", 8, &lanes_avx512_impl::rnea, &lanes_avx512_impl::gravity,
-                                &lanes_avx512_impl::mass_matrix};
+                                &lanes_avx512_impl::mass_matrix,
+                                &lanes_avx512_impl::regressor};
 }  // namespace dynid::detail

@@ -14,6 +14,9 @@ struct BatchJoint {
   double m, h[3];
   double I[6];  // xx, xy, xz, yy, yz, zz about the origin of J_i
   double Ia, Fv, Fs;
+  // Link i's DH frame in J_i (Model::link_offset): identity (modified DH) or Tx(a) Rx(alpha).
+  int offset_identity;
+  double offset_cos_alpha, offset_sin_alpha, offset_a;
 };
 
 struct BatchModel {
@@ -28,6 +31,11 @@ using BatchRnea = long (*)(const BatchModel&, const double* q, const double* qd,
                            double* tau, long T);
 using BatchGravity = long (*)(const BatchModel&, const double* q, double* g, long T);
 using BatchMassMatrix = long (*)(const BatchModel&, const double* q, double* M, long T);
+// The torque regressor (T, n, P) with P = 10n [+ n rotor] [+ 2n friction] columns, or only the
+// C columns listed in `columns` ((T, n, C)) when it is not null.
+using BatchRegressor = long (*)(const BatchModel&, const double* q, const double* qd,
+                                const double* qdd, int rotor, int friction, const int* columns,
+                                int C, double* Y, long T);
 
 struct LaneKernels {
   const char* name;  // "sse2", "avx2", "avx512"
@@ -35,6 +43,7 @@ struct LaneKernels {
   BatchRnea rnea;
   BatchGravity gravity;
   BatchMassMatrix mass_matrix;
+  BatchRegressor regressor;
 };
 
 // Defined in cpp/src/batch/lanes_*.cpp (the AVX ones on x86-64 only).
@@ -44,5 +53,7 @@ extern const LaneKernels lanes_avx512;
 
 // Joints above this use the scalar kernels (the lane kernels keep per-link arrays on the stack).
 constexpr int kMaxBatchJoints = 128;
+// The regressor's lane kernel keeps n x P vectors on the stack: up to this many joints.
+constexpr int kMaxRegressorLaneJoints = 16;
 
 }  // namespace dynid::detail
