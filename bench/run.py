@@ -45,6 +45,7 @@ TARGETS: dict[tuple[str, str], tuple[str, float]] = {
     ("Python batch", "gravity"): ("abs", 0.06),
     ("Python batch", "mass_matrix"): ("abs", 0.25),
     ("Python batch", "regressor"): ("abs", 0.5),
+    ("Python batch", "regressor_out"): ("abs", 0.5),
 }
 # What each row times on the Pinocchio side, for the table.
 PINOCCHIO_NAMES = {
@@ -61,6 +62,7 @@ PINOCCHIO_NAMES = {
     ("Python batch", "gravity"): "Python loop of pin.computeGeneralizedGravity",
     ("Python batch", "mass_matrix"): "Python loop of pin.crba",
     ("Python batch", "regressor"): "Python loop of pin.computeJointTorqueRegressor",
+    ("Python batch", "regressor_out"): "Python loop of pin.computeJointTorqueRegressor",
 }
 
 
@@ -312,7 +314,7 @@ def main() -> None:
         rows.append(
             make_row("Python batch", "rnea", batch["dynid"], batch["pinocchio"], unit="us/state")
         )
-        for name in ("gravity", "mass_matrix", "regressor"):
+        for name in ("gravity", "mass_matrix", "regressor", "regressor_out"):
             k = kernels[name]
             rows.append(make_row("Python batch", name, k["dynid"], k["pinocchio"], unit="us/state"))
 
