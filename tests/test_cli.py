@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from dynid.cli import main
 from dynid.io import save_log
-from dynid.log_identification import load_result
-from dynid.model_files import save_model
+from dynid.io.model_files import save_model
+from dynid.io.result_files import load_result
 from test_log_identification import PNG, fourier_log
 
 

@@ -159,7 +159,7 @@ def test_condition_number_matches_an_independent_stacking(lwr, rotor, friction) 
 
 
 def test_gradient_of_the_objective_matches_finite_differences(lwr) -> None:
-    from dynid.excitation import _LogCondition  # the optimiser's core, checked directly
+    from dynid.excitation.optimization import _LogCondition  # the optimiser's core, checked directly
 
     rng = np.random.default_rng(SEED)
     base = dynid.base_parameters(lwr, "torque", rotor=True, friction=True)

@@ -19,6 +19,7 @@ import warnings
 
 import dynid
 import dynid.cli
+import dynid.demo
 import numpy as np
 import pytest
 from dynid import excitation, signal
@@ -265,13 +266,13 @@ def test_demo_with_too_few_configurations_exits_2_with_one_line(tmp_path, capsys
 
 
 def test_demo_minimum_sizes_are_checked_by_one_function():
-    assert dynid.cli.check_demo_sizes(3, 1) == (3, 1)
+    assert dynid.demo.check_demo_sizes(3, 1) == (3, 1)
     with pytest.raises(ValueError, match=r"^train: expected an integer >= 3"):
-        dynid.cli.check_demo_sizes(2, 1)
+        dynid.demo.check_demo_sizes(2, 1)
     with pytest.raises(ValueError, match=r"^validation: expected an integer >= 1"):
-        dynid.cli.check_demo_sizes(3, 0)
+        dynid.demo.check_demo_sizes(3, 0)
     with pytest.raises(ValueError, match=r"^train: "):
-        dynid.cli.check_demo_sizes(True, 1)
+        dynid.demo.check_demo_sizes(True, 1)
 
 
 # --------------------------------------------------------------------------- the helper itself

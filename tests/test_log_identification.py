@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from dynid.identify import RankDeficientError
 from dynid.io import Log
-from dynid.log_identification import identify_log, load_result, validate_log
+from dynid.io.result_files import load_result, save_result
+from dynid.log_identification import identify_log, validate_log
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -118,7 +119,7 @@ def test_preparation_is_applied_and_recorded(lwr):
 
 
 def test_save_and_load_round_trip(lwr, lwr_result, tmp_path):
-    path = lwr_result.save(tmp_path / "out")
+    path = save_result(lwr_result, tmp_path / "out")
     assert path == tmp_path / "out" / "result.json"
     for name in ("torques.png", "residuals.png"):
         assert (tmp_path / "out" / name).read_bytes()[:8] == PNG
@@ -156,7 +157,7 @@ CORRUPT = [
 
 @pytest.mark.parametrize("change, message", CORRUPT)
 def test_malformed_result_files_name_the_field(lwr_result, tmp_path, change, message):
-    path = lwr_result.save(tmp_path, plots=False)
+    path = save_result(lwr_result, tmp_path, plots=False)
     data = json.loads(path.read_text())
     change(data)
     path.write_text(json.dumps(data))

@@ -1,4 +1,4 @@
-"""Model files (dynid.model_files): round trips, the LWR4+ tables against pinocchio, errors."""
+"""Model files (dynid.io.model_files): round trips, the LWR4+ tables against pinocchio, errors."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import dynid
 import numpy as np
 import pytest
-from dynid.model_files import BUILTIN_MODELS, load_model, model_from_dict, save_model
+from dynid.io.model_files import BUILTIN_MODELS, load_model, model_from_dict, save_model
 
 DATA = Path(__file__).parent / "data"
 EXAMPLES = Path(__file__).parent.parent / "examples"

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from dynid.io import Log, load_log
 from dynid.log_identification import identify_log, validate_log
-from dynid.model_files import load_model
+from dynid.io.model_files import load_model
 
 DATA = Path(__file__).parent / "data"
 EXAMPLES = Path(__file__).parent.parent / "examples"

@@ -7,6 +7,7 @@
 #include "fast_calls.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
+#include "simulator.hpp"
 
 namespace py = pybind11;
 
@@ -16,6 +17,7 @@ PYBIND11_MODULE(_core, m) {
   dynid::binding::bind_batch(m);
   dynid::binding::bind_fast_calls(m);
   dynid::binding::bind_recursive_least_squares(m);
+  dynid::binding::bind_simulator(m);
   m.def(
       "standard_parameters",
       [](double mass, py::handle com, py::handle inertia_com) {

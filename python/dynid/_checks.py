@@ -115,3 +115,60 @@ def count(value: Any, name: str, minimum: int, why: str = "") -> int:
         reason = f" ({why})" if why else ""
         raise ValueError(f"{name}: expected an integer >= {minimum}{reason}, got {value!r}")
     return int(value)
+
+
+def is_integer(value: Any) -> bool:
+    """True for Python and NumPy integers, False for booleans (which are integers to Python)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def index(value: Any, name: str, size: int) -> int:
+    """An integer index in [0, size) (bool refused), as an int."""
+    if not is_integer(value) or not 0 <= value < size:
+        raise ValueError(f"{name}: expected an integer index in [0, {size}), got {value!r}")
+    return int(value)
+
+
+def indices(value: Any, name: str, size: int) -> tuple[int, ...]:
+    """A sequence of distinct integer indices in [0, size), as a tuple (None is refused)."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise ValueError(f"{name}: expected a sequence of indices in [0, {size}), got {value!r}")
+    items = list(value)
+    for item in items:
+        index(item, name, size)
+    if len(set(items)) != len(items):
+        raise ValueError(f"{name}: repeated index in {items!r}")
+    return tuple(int(i) for i in items)
+
+
+def flag(value: Any, name: str) -> bool:
+    """True or False exactly (SPEC 2: ``rotor="no"`` must not read as True)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ValueError(f"{name}: expected True or False, got {value!r}")
+
+
+def text(value: Any, name: str, expected: str) -> str:
+    """A string; anything else is a ValueError saying what was ``expected``."""
+    if isinstance(value, str):
+        return value
+    raise ValueError(f"{name}: expected {expected}, got {value!r}")
+
+
+def names(value: Any, name: str, size: int) -> list[str]:
+    """A list of ``size`` strings (a tuple or other sequence is accepted)."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise ValueError(f"{name}: expected a sequence of {size} strings, got {value!r}")
+    items = list(value)
+    if len(items) != size or not all(isinstance(item, str) for item in items):
+        raise ValueError(f"{name}: expected a sequence of {size} strings, got {value!r}")
+    return items
+
+
+def robot(value: Any, name: str = "robot") -> Any:
+    """A dynid robot model (a ``dynid.Robot`` or the C++ model it wraps)."""
+    from ._core import Model  # the compiled module; imported here to keep this module pure
+
+    if not isinstance(value, Model):
+        raise ValueError(f"{name}: expected a dynid.Robot, got {type(value).__name__}")
+    return value

@@ -19,17 +19,16 @@ import functools
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from threadpoolctl import ThreadpoolController
-
 F = TypeVar("F", bound=Callable[..., Any])
 
-_controller: ThreadpoolController | None = None
+_controller: Any = None  # threadpoolctl.ThreadpoolController, made on first use
 
 
-def _libraries() -> ThreadpoolController:
+def _libraries() -> Any:
     global _controller
-    if _controller is None:
+    if _controller is None:  # imported here: `import dynid` stays fast
         import scipy.linalg  # noqa: F401 -- SciPy's own OpenBLAS must be loaded to be found
+        from threadpoolctl import ThreadpoolController
 
         _controller = ThreadpoolController()
     return _controller

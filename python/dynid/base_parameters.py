@@ -12,7 +12,8 @@ Each dropped column is then expressed on the kept ones, which gives
 for every sample, with beta = [I | T] (rearranged to the standard order).
 
 Base parameters are structural: they depend on the DH table, the joint types and the direction
-of gravity, not on the parameter values; the result is cached on the robot per kind.
+of gravity, not on the parameter values nor on the joint limits; the result is cached on the
+robot per kind and per geometry.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from . import _checks as checks
+from ._equality import ValueEquality
 from ._threads import blas_single_threaded
 from .robot import Robot
 
@@ -41,8 +44,8 @@ NOISE_RATIO = 1e-10
 KINDS = ("torque", "gravity", "inertia")
 
 
-@dataclass(frozen=True)
-class BaseParameters:
+@dataclass(frozen=True, eq=False)
+class BaseParameters(ValueEquality):
     """The base (grouped) parameters of a robot for one kind of regressor."""
 
     kind: str
@@ -73,13 +76,17 @@ def base_parameters(
     ``rotor`` and ``friction`` append the Ia and Fv/Fs columns as in :meth:`Robot.regressor`
     (the gravity regressor has neither; the inertia regressor has no friction).
     """
-    if kind not in KINDS:
+    checks.robot(robot)
+    if not isinstance(kind, str) or kind not in KINDS:
         raise ValueError(f"kind: expected one of {KINDS}, got {kind!r}")
+    rotor, friction = checks.flag(rotor, "rotor"), checks.flag(friction, "friction")
     if kind == "gravity" and (rotor or friction):
         raise ValueError("rotor/friction: the gravity regressor has no drive-term columns")
     if kind == "inertia" and friction:
         raise ValueError("friction: the inertia regressor has no friction columns")
-    key = (kind, bool(rotor), bool(friction), tuple(robot.gravity_vector), tuple(robot.base.ravel()))
+    # Everything the structure depends on (SPEC 3: not the parameter values, nor the limits).
+    key = (kind, bool(rotor), bool(friction), robot.convention, robot.joint_types,
+           robot.dh.tobytes(), robot.gravity_vector.tobytes(), robot.base.tobytes())
     cache = robot.__dict__.setdefault("_base_parameter_cache", {})
     if key not in cache:
         cache[key] = _compute(robot, kind, bool(rotor), bool(friction))
@@ -89,10 +96,14 @@ def base_parameters(
 def stacked_regressor(
     robot: Robot, kind: str, rotor: bool, friction: bool, samples: int, seed: int = 0
 ) -> NDArray[np.float64]:
-    """The regressor of ``kind`` on ``samples`` random states within the joint limits, stacked
-    into one (rows, P) matrix."""
+    """The regressor of ``kind`` on ``samples`` random states, stacked into one (rows, P) matrix.
+
+    The configurations ignore the joint limits (SPEC 3: base parameters are structural): revolute
+    joints cover the full circle and prismatic ones [-1, 1] m, so that tight limits cannot make
+    a generic dependency look structural (or hide one)."""
     rng = np.random.default_rng(seed)
-    q = robot.random_configurations(samples, seed=rng.integers(2**32))
+    revolute = np.array([t == "R" for t in robot.joint_types])
+    q = rng.uniform(-1.0, 1.0, (samples, robot.n)) * np.where(revolute, np.pi, 1.0)
     if kind == "gravity":
         Y = robot.gravity_regressor(q)
     elif kind == "inertia":

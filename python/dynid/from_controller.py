@@ -20,6 +20,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _checks as checks
+from ._equality import ValueEquality
 from ._checks import real_array
 from .base_parameters import (
     BaseParameters,
@@ -43,8 +45,8 @@ class ZeroElement:
     constraints: list[str]  #: readable linear constraints on the standard parameters, "... = 0"
 
 
-@dataclass
-class IdentifiedModel:
+@dataclass(eq=False)
+class IdentifiedModel(ValueEquality):
     """The model rebuilt from identified coefficients; usable like a Robot for prediction.
 
     ``gravity``, ``mass_matrix``, ``coriolis``, ``coriolis_matrix`` and ``rnea`` (the joint
@@ -132,7 +134,9 @@ def identify_from_controller(
         M, so weighting each element by its own residual variance gives honest standard
         deviations where the pooled variance of OLS understates them.
     """
+    checks.robot(structure, "structure")
     n = structure.n
+    exclude_gravity_joints = checks.indices(exclude_gravity_joints, "exclude_gravity_joints", n)
     q = _samples(q, "q", (n,))
     g = _samples(g, "g", (n,))
     M = _samples(M, "M", (n, n))
@@ -143,7 +147,7 @@ def identify_from_controller(
     inertia_base = base_parameters(structure, "inertia")
     Yg = gravity_base.reduce(structure.gravity_regressor(q))  # (N, n, p_g), eq. (21)
     gravity_fit = least_squares(
-        Yg, g, method=method, exclude_joints=tuple(exclude_gravity_joints),
+        Yg, g, method=method, exclude_joints=exclude_gravity_joints,
         names=gravity_base.names,
     )
 

@@ -22,7 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _checks as checks
 from ._checks import real_array
+from ._equality import ValueEquality
 from ._qr import GroupedTriangularFactors, solve_triangular_system
 from ._threads import blas_single_threaded
 
@@ -49,8 +51,8 @@ class RankDeficientError(ValueError):
     """The data do not excite all base parameters: the stacked regressor has rank < p."""
 
 
-@dataclass(frozen=True)
-class LeastSquaresResult:
+@dataclass(frozen=True, eq=False)
+class LeastSquaresResult(ValueEquality):
     """An estimate theta of the p parameters with its uncertainty (see :func:`least_squares`)."""
 
     theta: NDArray[np.float64]  #: (p,) estimate
@@ -201,9 +203,7 @@ def solve_factors(
     """The OLS or WLS estimate of :func:`least_squares` from accumulated triangular factors."""
     rows, p = factors.rows, factors.p
     if names is not None:
-        names = [str(name) for name in names]
-        if len(names) != p:
-            raise ValueError(f"names: expected {p} names (one per column of Y), got {len(names)}")
+        names = checks.names(names, "names", p)
     if rows < p:
         raise RankDeficientError(
             f"Y: {rows} stacked rows for {p} parameters; at least {p} rows are needed "
@@ -339,18 +339,7 @@ def _samples(Y: ArrayLike, tau: ArrayLike) -> tuple[NDArray[np.float64], NDArray
 
 
 def _excluded(exclude_joints: Sequence[int], n: int) -> set[int]:
-    try:
-        values = list(exclude_joints)
-    except TypeError:
-        raise ValueError(
-            f"exclude_joints: expected a sequence of joint indices, got {exclude_joints!r}"
-        ) from None
-    for j in values:
-        integer = isinstance(j, (int, np.integer)) and not isinstance(j, (bool, np.bool_))
-        if not integer or not 0 <= j < n:
-            raise ValueError(
-                f"exclude_joints: expected 0-based joint indices in [0, {n}), got {exclude_joints!r}"
-            )
+    values = checks.indices(exclude_joints, "exclude_joints", n)
     if len(set(values)) == n:
         raise ValueError(f"exclude_joints: {exclude_joints!r} leaves no joint of {n}")
     return {int(j) for j in values}

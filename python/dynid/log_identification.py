@@ -11,11 +11,16 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
 3. optionally one constant column per joint is appended: a torque offset (sensor bias; with
    Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-);
 4. the stacked system is solved by OLS or WLS (``dynid.streaming``: the regressor chunk by
-   chunk into triangular factors, the solver of ``dynid.identify.least_squares``).
+   chunk into triangular factors, the solver of ``dynid.identify.least_squares``);
+5. with ``physical=True``, the standard parameters are then estimated by the physically
+   consistent semidefinite programme (``dynid.physical.physical_least_squares``: same columns,
+   same WLS weights, the offsets unconstrained, optionally a prior model), and the result carries
+   that robot (``result.robot``, saved with the result) and its base values as ``theta``.
 
 The result predicts torques on any log (``predict``), is checked on another log
-(:func:`validate_log`) and is saved to a folder (JSON with everything needed to apply it again,
-including the model's DH table, plus PNG plots) and loaded back (:func:`load_result`).
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result` (JSON with everything needed
+to apply it again, including the model's DH table, plus PNG plots) and loaded back by
+:func:`dynid.load_result`.
 """
 
 from __future__ import annotations
@@ -28,9 +33,13 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
+from ._equality import ValueEquality
 from .base_parameters import base_parameters
-from .io import Log, prepare_log
-from .model_files import model_from_dict, model_to_dict
+from .identify import VARIANCE_FLOOR
+from .io.log_files import Log
+from .io.model_files import load_model, model_from_dict, model_to_dict
+from .io.preparation import prepare_log
+from .physical import physical_least_squares
 from .robot import Robot
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
@@ -39,6 +48,12 @@ PathLike = Union[str, Path]
 
 #: Name of the torque-offset coefficient of joint j (1-based): "off1", "off2", ...
 OFFSET_NAME = "off"
+
+#: prior_weight of ``identify_log(physical=True, prior=...)`` when none is given: on the LWR4+
+#: logs (docs/real_data.md, "Physically consistent identification") the largest decade at which
+#: the relative training residual of the physical fit rises by less than 10 % over the prior-free
+#: fit; it pins the masses near the prior's while leaving the excited directions to the data.
+DEFAULT_PRIOR_WEIGHT = 1e-5
 
 #: Samples per regressor chunk folded into the least-squares factors.
 STREAM_CHUNK = 8192
@@ -49,7 +64,7 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 
 @dataclass(eq=False)
-class LogIdentification:
+class LogIdentification(ValueEquality):
     """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
@@ -57,9 +72,15 @@ class LogIdentification:
     ``independent`` and ``beta`` are those of :class:`dynid.BaseParameters` for the model's
     regressor columns ``parameter_names``. ``training`` holds the training log's source, size,
     preparation (options and notes, in words) and per-joint fit metrics.
+
+    A physically consistent result (``identify_log(physical=True)``) has ``physical`` set (the
+    solver's report: status, solver, times, prior, prior_weight, margin) and ``model`` holds the
+    identified standard parameters and drive terms, so ``robot`` is the identified robot;
+    ``theta`` holds its base values (beta @ pi) and the offsets; ``std`` is inf and
+    ``covariance`` None (the constrained estimate has no least-squares covariance).
     """
 
-    model: dict[str, Any]  #: the robot model (``dynid.model_files`` format): DH table etc.
+    model: dict[str, Any]  #: the robot model (``dynid.io.model_files`` format): DH table etc.
     rotor: bool
     friction: bool
     offset: bool
@@ -75,9 +96,13 @@ class LogIdentification:
     condition_number: float
     rank: int
     excluded: tuple[int, ...] = ()
+    #: (count, count) covariance of ``theta`` (None for results saved before format version 2)
+    covariance: NDArray[np.float64] | None = None
     training: dict[str, Any] = field(default_factory=dict)
-    log: Log | None = field(default=None, repr=False)  #: the prepared training log (not saved)
-    _robot: Robot | None = field(default=None, repr=False)
+    physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
+    #: the prepared training log (not saved, not compared)
+    log: Log | None = field(default=None, repr=False, compare=False)
+    _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
     def n(self) -> int:
@@ -91,8 +116,9 @@ class LogIdentification:
 
     @property
     def robot(self) -> Robot:
-        """The robot model, rebuilt from ``model`` (its parameters are the prior ones, not the
-        identified ones: these exist only as the base combinations ``theta``)."""
+        """The robot model, rebuilt from ``model``. For a least-squares result its parameters are
+        not the identified ones (these exist only as the base combinations ``theta``); for a
+        physically consistent one (``physical`` set) it is the identified robot."""
         if self._robot is None:
             self._robot = model_from_dict(self.model)
         return self._robot
@@ -136,6 +162,13 @@ class LogIdentification:
         fit = (f"{self.count} base parameters{offsets}, {self.method.upper()}, rank "
                f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}")
         head = [model, fit]
+        if self.physical is not None:
+            report = self.physical
+            prior = (f"prior {report.get('prior')} (weight {report.get('prior_weight'):g})"
+                     if report.get("prior") else "no prior")
+            head.append(f"physically consistent fit: SDP, {report.get('solver')} status "
+                        f"{report.get('status')}, {prior}; the values are the base parameters of "
+                        "the identified robot (no standard deviations)")
         width = max(11, *(len(name) for name in self.names))
         title = f"  {'coefficient':<{width}}  {'value':>12}  {'std':>10}  {'rel.std':>8}  expression"
         lines = [title]
@@ -150,15 +183,6 @@ class LogIdentification:
             text += validation_table(arrays)
         return text
 
-    def save(self, folder: PathLike, log: Log | None = None, plots: bool = True) -> Path:
-        """Write ``result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of the
-        fit on ``log`` (default: the training log, when kept) into ``folder``; returns the JSON
-        path."""
-        from .result_files import save_result
-
-        log = log if log is not None else self.log
-        return save_result(self, folder, log if plots else None)
-
 
 def identify_log(
     log: Log,
@@ -170,6 +194,9 @@ def identify_log(
     method: str = "wls",
     exclude_joints: Sequence[int] = (),
     preparation: Mapping[str, Any] | None = None,
+    physical: bool = False,
+    prior: Robot | PathLike | None = None,
+    prior_weight: float | None = None,
 ) -> LogIdentification:
     """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
 
@@ -180,6 +207,17 @@ def identify_log(
     default: the joints' torques differ by two orders of magnitude). ``exclude_joints`` (0-based)
     leaves those joints' rows out of the fit. Raises ValueError (RankDeficientError) when the log
     does not excite every base parameter.
+
+    ``physical=True`` estimates physically consistent standard parameters instead
+    (:func:`dynid.physical_least_squares`, same columns; WLS weights 1/sigma_j from the
+    least-squares residuals; the offsets unconstrained; excluded joints weighted 0). ``prior`` is a
+    Robot, a URDF file or a model file (``dynid.load_model``: JSON/YAML or a built-in name) of
+    the same arm, in any DH table (re-expressed in ``robot``'s frames by
+    :func:`dynid.link_frames.express_in_frames_of` when needed); ``prior_weight`` defaults to
+    ``DEFAULT_PRIOR_WEIGHT`` when a prior is given. A log that does not excite every base
+    parameter is then a RuntimeWarning, not an error: the constraints and the prior fix the
+    unexcited directions (without a prior, any values the constraints allow). Raises
+    :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):
         raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
@@ -189,6 +227,13 @@ def identify_log(
         raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
             f"robot: expected a dynid.Robot, got {type(robot).__name__}"
         )
+    if not isinstance(physical, (bool, np.bool_)):
+        raise ValueError(f"physical: expected True or False, got {physical!r}")
+    if not physical and (prior is not None or prior_weight is not None):
+        raise ValueError("prior: a prior (and prior_weight) needs physical=True")
+    prior_robot = _prior_model(prior) if prior is not None else None
+    if prior_robot is not None and prior_weight is None:
+        prior_weight = DEFAULT_PRIOR_WEIGHT
     options = _options(preparation)
     prepared = _with_derivatives(prepare_log(log, **options), robot.n, robot.name)
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=bool(friction))
@@ -204,23 +249,26 @@ def identify_log(
         relative_std=np.zeros(len(names)), condition_number=np.nan, rank=0, log=prepared,
         _robot=robot,
     )
-    # The regressor chunk by chunk into the triangular factors (dynid.streaming): memory bounded
-    # by a chunk whatever the log's length; a second pass predicts the torques for the metrics.
+    # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
+    # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
     chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
     accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
     for c in chunks:
         accumulator.add(result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]),
                         prepared.tau[c])
-    fit = accumulator.solve(method=method, names=names)
-    predicted = np.concatenate(
-        [result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]) @ fit.theta
-         for c in chunks]
-    )
+    # The physical fit needs the least squares only for the rank, the condition number and the
+    # WLS weights: directions the data do not excite are then fixed by the constraints and the
+    # prior, so rank deficiency is a warning there instead of an error.
+    fit = accumulator.solve(method=method, names=names,
+                            on_rank_deficient="warn" if physical else "raise")
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
+    result.covariance = fit.covariance
     result.excluded = fit.excluded
     for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
         result.model.pop(key, None)
+    if physical:
+        _physical(result, prepared, fit.noise_variance, prior_robot, prior_weight or 0.0, prior)
     result.training = {
         "source": prepared.source,
         "samples": prepared.T,
@@ -228,9 +276,90 @@ def identify_log(
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
         "notes": list(prepared.notes),
-        "metrics": error_metrics(prepared.tau, predicted),
+        "metrics": error_metrics(prepared.tau, np.concatenate(
+            [result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]) @ result.theta
+             for c in chunks])),
     }
     return result
+
+
+def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.float64],
+              prior: Robot | None, prior_weight: float, source: Any) -> None:
+    """Replace the least-squares estimate in ``result`` by the physically consistent one."""
+    robot, n = result.robot, result.n
+    Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
+    if Y.ndim == 2:
+        Y = Y[None]
+    extra = n if result.offset else 0
+    if extra:
+        Y = np.concatenate([Y, np.broadcast_to(np.eye(n), (Y.shape[0], n, n))], axis=2)
+    weights = np.ones(n)
+    kept = [j for j in range(n) if j not in result.excluded]
+    usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
+    if result.method == "wls" and usable:  # as dynid.least_squares: 1 / sigma_j
+        floored = np.maximum(noise_variance, VARIANCE_FLOOR * noise_variance.max())
+        weights[kept] = 1.0 / np.sqrt(floored)
+    weights[list(result.excluded)] = 0.0
+    fit = physical_least_squares(robot, Y, log.tau, rotor=result.rotor, friction=result.friction,
+                                 weights=weights, prior=prior, prior_weight=prior_weight,
+                                 extra_columns=extra)
+    result.theta = np.concatenate([fit.base_values, fit.extra])
+    result.std = np.full(result.theta.size, np.inf)
+    result.relative_std = np.full(result.theta.size, np.inf)
+    result.covariance = None
+    result.model = model_to_dict(fit.robot)
+    result._robot = fit.robot
+    result.physical = {
+        "status": fit.status, "solver": fit.solver,
+        "solve_time_s": fit.solve_time if np.isfinite(fit.solve_time) else None,
+        "setup_time_s": fit.setup_time, "objective": fit.objective,
+        "prior": None if source is None else (str(source) if not isinstance(source, Robot)
+                                              else f"<Robot {source.name}>"),
+        "prior_weight": prior_weight, "margin": fit.options["margin"],
+        "projected_links": [i + 1 for i in fit.projected],
+        "min_pseudo_inertia_eigenvalues": fit.min_eigenvalues.tolist(),
+    }
+
+
+def _prior_model(prior: Any) -> Robot:
+    """The prior: a Robot, or what ``dynid.load_model`` reads (a model file, a URDF, a built-in
+    name)."""
+    if isinstance(prior, Robot):
+        return prior
+    if not isinstance(prior, (str, Path)):
+        raise ValueError(f"prior: expected a dynid.Robot or the path of a model file or URDF, "
+                         f"got {type(prior).__name__}")
+    return load_model(prior)
+
+
+@dataclass(eq=False)
+class LogValidation(ValueEquality):
+    """An identified model applied to another log: the prepared log, the predicted torques and
+    the per-joint errors (:func:`dynid.validation.error_metrics`)."""
+
+    log: Log  #: the validation log after ``preparation``
+    predicted: NDArray[np.float64]
+    metrics: dict[str, NDArray[np.float64]]
+    preparation: dict[str, Any]
+    notes: list[str] = field(default_factory=list)  #: differences from the training preparation
+
+
+def run_validation(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> LogValidation:
+    """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
+    and measure the errors; ``notes`` says where the preparation differs from the training
+    log's (a low-pass on one and not the other biases the comparison)."""
+    options = _options(preparation)
+    prepared = prepare_log(log, **options) if options else log
+    predicted = result.predict(prepared)
+    notes = []
+    trained = result.training.get("preparation", {}).get("cutoff")
+    if trained != options.get("cutoff"):
+        notes.append(f"the training log was {_filtered(trained)}, this one is "
+                     f"{_filtered(options.get('cutoff'))}")
+    return LogValidation(prepared, predicted, error_metrics(prepared.tau, predicted), options,
+                         notes)
 
 
 def validate_log(
@@ -239,16 +368,11 @@ def validate_log(
     """Per-joint errors of ``result`` on another log (``prepare_log(log, **preparation)``
     first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
     ``r2`` and ``mse`` (see :func:`dynid.validation.error_metrics`)."""
-    options = _options(preparation)
-    prepared = prepare_log(log, **options) if options else log
-    return error_metrics(prepared.tau, result.predict(prepared))
+    return run_validation(result, log, preparation=preparation).metrics
 
 
-def load_result(path: PathLike) -> LogIdentification:
-    """A result saved by :meth:`LogIdentification.save`: its folder or its ``result.json``."""
-    from .result_files import load_result as _load
-
-    return _load(path)
+def _filtered(cutoff: float | None) -> str:
+    return "not low-passed" if cutoff is None else f"low-passed at {cutoff:g} Hz"
 
 
 def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:

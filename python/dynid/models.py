@@ -1,4 +1,5 @@
-"""Ready-made robot models: the KUKA LWR-IV, the lecture's planar 2R and the PUMA 560.
+"""Ready-made robot models: the KUKA LWR-IV, the lecture's planar 2R, the PUMA 560, the Franka
+Emika Panda (Gaz et al. 2019) and the Universal Robots UR5 and UR10 (from their URDFs).
 
 Each factory returns a fresh :class:`dynid.Robot` built with ``Robot.from_dh``.
 Units are SI, angles in radians, standard inertial parameters as in SPEC §2.
@@ -7,13 +8,14 @@ Units are SI, angles in radians, standard inertial parameters as in SPEC §2.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from importlib.resources import files
 
 import numpy as np
 
 from . import _core
 from .robot import Robot
 
-__all__ = ["kuka_lwr4", "planar_2r", "puma560"]
+__all__ = ["kuka_lwr4", "panda", "planar_2r", "puma560", "ur5", "ur10"]
 
 _DEG = np.pi / 180.0
 
@@ -242,3 +244,99 @@ def puma560() -> Robot:
     robot.Fv = visc * gear**2
     robot.Fs = np.abs(gear) * (np.abs(tc_pos) + np.abs(tc_neg)) / 2.0
     return robot
+
+
+# Franka Emika Panda, modified DH (Craig) rows (a_{i-1}, alpha_{i-1}, d_i, theta_i) of Gaz et al.
+# 2019 (``matlab/utils/Load_Franka_DH.m``); flange d = 0.107 m after joint 7.
+_PANDA_DH = np.array([
+    [0.0,     0.0,         0.333, 0.0],
+    [0.0,    -np.pi / 2,   0.0,   0.0],
+    [0.0,     np.pi / 2,   0.316, 0.0],
+    [0.0825,  np.pi / 2,   0.0,   0.0],
+    [-0.0825, -np.pi / 2,  0.384, 0.0],
+    [0.0,     np.pi / 2,   0.0,   0.0],
+    [0.088,   np.pi / 2,   0.0,   0.0],
+])  # fmt: skip
+_PANDA_FLANGE = 0.107
+# Joint limits [rad] of the Panda (Franka Control Interface documentation, "Robot and interface
+# specifications"; the same numbers are in franka_description's URDF).
+_PANDA_QLIM = np.array([
+    [-2.8973, 2.8973], [-1.7628, 1.7628], [-2.8973, 2.8973], [-3.0718, -0.0698],
+    [-2.8973, 2.8973], [-0.0175, 3.7525], [-2.8973, 2.8973],
+])  # fmt: skip
+
+
+def panda() -> Robot:
+    """Franka Emika Panda with the feasible dynamic parameters identified by Gaz et al.
+
+    Source: C. Gaz, M. Cognetti, A. Oliva, P. Robuffo Giordano, A. De Luca, "Dynamic
+    Identification of the Franka Emika Panda Robot With Retrieval of Feasible Parameters Using
+    Penalty-Based Optimization", IEEE Robotics and Automation Letters 4(4), pp. 4147-4154, 2019;
+    supplementary material Tables VIII and IX, column p-hat (the retrieved feasible parameters:
+    mass, centre of mass and inertia about it, per link), shipped as
+    ``dynid/data/franka_panda_gaz2019.csv`` (provenance in ``dynid/data/README.md``).
+
+    Kinematics: the paper's modified DH (Craig) table, a_3 = 0.0825, a_4 = -0.0825,
+    a_6 = 0.088, d_1 = 0.333, d_3 = 0.316, d_5 = 0.384 m, frame 0 = ``panda_link0`` of the
+    franka_description URDF (whose link frames are these DH frames), and the flange
+    (``panda_link8``, 0.107 m along z_7) as the tool transform. Joint limits from Franka's
+    specifications. c1z is 0 (the paper marks it as not influencing the dynamics). The paper's
+    friction model (sigmoids) has no place in Fv, Fs: the drive terms are zero.
+
+    Returns
+    -------
+    Robot
+        A 7-DOF robot named ``"Franka Emika Panda"`` (modified DH).
+    """
+    table = np.loadtxt(_data_file("franka_panda_gaz2019.csv"), delimiter=",", comments="#",
+                       skiprows=7)
+    tool = np.eye(4)
+    tool[2, 3] = _PANDA_FLANGE
+    robot = Robot.from_dh(_PANDA_DH, joint_types="R" * 7, convention="modified",
+                          gravity=(0.0, 0.0, -9.81), tool=tool, qlim=_PANDA_QLIM,
+                          name="Franka Emika Panda")
+    for i, (_, m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz) in enumerate(table):
+        inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        robot.set_link(i, m, (cx, cy, cz), inertia)
+    return robot
+
+
+def ur5(convention: str = "standard") -> Robot:
+    """Universal Robots UR5, read with ``Robot.from_urdf`` from its URDF (shipped as
+    ``dynid/data/ur5.urdf``).
+
+    Source: ``ur5_robot.urdf`` of ros-industrial/universal_robot ``ur_description`` (BSD), as in
+    example-robot-data 6.0.0 (provenance in ``dynid/data/README.md``): kinematics of Universal
+    Robots' published DH parameters (d1 = 0.089159, a2 = -0.425, a3 = -0.39225,
+    d4 = 0.10915, d5 = 0.09465, d6 = 0.0823 m), the link masses published by Universal Robots
+    (3.7, 8.393, 2.275, 1.219, 1.219, 0.1879 kg) with the URDF's cylinder-approximation
+    inertias. The chain runs from the URDF root (``world``) to ``tool0`` (the tool flange, as
+    the tool transform); q is the URDF joint position, limits +-2 pi (elbow +-pi), no friction.
+    """
+    return _ur("ur5.urdf", "UR5", convention)
+
+
+def ur10(convention: str = "standard") -> Robot:
+    """Universal Robots UR10, read with ``Robot.from_urdf`` from its URDF (shipped as
+    ``dynid/data/ur10.urdf``).
+
+    Source: ``ur10_robot.urdf`` of ros-industrial/universal_robot ``ur_description`` (BSD), as in
+    example-robot-data 6.0.0 (provenance in ``dynid/data/README.md``): kinematics of Universal
+    Robots' published DH parameters (d1 = 0.1273, a2 = -0.612, a3 = -0.5723, d4 = 0.163941,
+    d5 = 0.1157, d6 = 0.0922 m), the link masses published by Universal Robots (7.778, 12.93,
+    3.87, 1.96, 1.96, 0.202 kg) with the URDF's cylinder-approximation inertias. The chain runs
+    from the URDF root (``world``) to ``tool0``; q is the URDF joint position, limits +-2 pi
+    (elbow +-pi), no friction.
+    """
+    return _ur("ur10.urdf", "UR10", convention)
+
+
+def _ur(file: str, name: str, convention: str) -> Robot:
+    robot = Robot.from_urdf(_data_file(file).read_text(encoding="utf-8"), tip_link="tool0",
+                            convention=convention)
+    robot.name = name
+    return robot
+
+
+def _data_file(name: str):
+    return files("dynid").joinpath("data", name)

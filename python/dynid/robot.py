@@ -9,10 +9,12 @@ the GIL released.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _checks as checks
 from . import _core
 
 PARAMETER_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
@@ -86,8 +88,8 @@ class Robot(_core.Model):
         n = shape[0]
         if joint_types is None:
             joint_types = "R" * n
-        joint_types = _text(joint_types, "joint_types", "a string of 'R'/'P'")
-        convention = _text(convention, "convention", "'standard' or 'modified'")
+        joint_types = checks.text(joint_types, "joint_types", "a string of 'R'/'P'")
+        convention = checks.text(convention, "convention", "'standard' or 'modified'")
         robot = cls(dh, joint_types.upper(), convention, gravity, base, tool)
         if params is not None:
             robot.params = params
@@ -96,6 +98,57 @@ class Robot(_core.Model):
         if name:
             robot.name = name
         return robot
+
+    @classmethod
+    def from_urdf(
+        cls,
+        urdf: str | Path,
+        base_link: str | None = None,
+        tip_link: str | None = None,
+        convention: str = "standard",
+        gravity: ArrayLike = (0.0, 0.0, -9.81),
+    ) -> Robot:
+        """Build a robot from the serial chain of a URDF (SPEC 6; docs/urdf.md).
+
+        ``urdf`` is a path or the XML text. The chain runs from ``base_link`` (default: the root
+        link) to ``tip_link`` (default: the single leaf reached through movable joints). Its
+        revolute, continuous and prismatic joints are the n joints and **q is the URDF joint
+        position** (same zero, same sign); fixed joints are merged. The DH table (``convention``)
+        has z along each joint axis, theta/d offsets, and base and tool transforms such that
+        ``fkine(q)`` is the pose of ``tip_link`` in ``base_link``'s frame (the world). Inertials
+        become standard parameters in the DH frames, ``<limit>`` goes to ``qlim`` (continuous
+        joints: (-pi, pi)), ``<dynamics damping friction>`` to ``Fv`` and ``Fs``.
+
+        ValueError (naming the joint, link or argument) for malformed XML, a branched tree
+        without ``tip_link``, floating, planar or mimic joints on the chain, a moving link
+        without any inertial, an axis of zero length.
+        """
+        from .urdf import dh_model_from_urdf  # on first use: import dynid stays fast
+
+        model = dh_model_from_urdf(urdf, base_link, tip_link, convention)
+        robot = cls.from_dh(model.dh, model.joint_types, convention, gravity, model.params,
+                            model.base, model.tool, model.qlim, model.name)
+        robot.Ia, robot.Fv, robot.Fs = model.Ia, model.Fv, model.Fs
+        return robot
+
+    def to_urdf(
+        self, name: str = "robot", path: str | Path | None = None, overwrite: bool = False
+    ) -> str:
+        """The robot as URDF text (SPEC 6; docs/urdf.md); with ``path`` also written there
+        (atomically; an existing file only with ``overwrite=True``).
+
+        One URDF link per DH link with its inertial about the centre of mass, joints with axis
+        z, ``qlim`` as limits, Fv and Fs as ``<dynamics damping friction>``, the base and tool
+        transforms as fixed placements, and Ia (no URDF field) as a ``dynid: Ia`` comment that
+        :meth:`from_urdf` reads back. ValueError naming the first link that is not physically
+        consistent.
+        """
+        from .urdf import urdf_text, write_urdf  # on first use: import dynid stays fast
+
+        text = urdf_text(self, name)
+        if path is not None:
+            write_urdf(text, path, overwrite)
+        return text
 
     # ---- limits and labels -------------------------------------------------------------------
     @property
@@ -128,9 +181,7 @@ class Robot(_core.Model):
         Raises ValueError unless m > 0 and the inertia is positive definite and satisfies the
         triangle inequalities.
         """
-        valid_index = isinstance(i, (int, np.integer)) and not isinstance(i, (bool, np.bool_))
-        if not valid_index or not 0 <= i < self.n:
-            raise ValueError(f"i: expected an integer link index in [0, {self.n}), got {i!r}")
+        i = checks.index(i, "i", self.n)
         try:
             mass_value = float(mass)
         except (TypeError, ValueError):
@@ -145,8 +196,8 @@ class Robot(_core.Model):
     def parameter_vector(self, rotor: bool = False, friction: bool = False) -> NDArray[np.float64]:
         """The parameter vector pi matching the regressor's columns: the 10n standard parameters,
         then Ia (n) if ``rotor``, then Fv (n) and Fs (n) if ``friction``."""
-        _flag(rotor, "rotor")
-        _flag(friction, "friction")
+        checks.flag(rotor, "rotor")
+        checks.flag(friction, "friction")
         parts = [self.params.reshape(-1)]
         if rotor:
             parts.append(self.Ia)
@@ -156,8 +207,8 @@ class Robot(_core.Model):
 
     def parameter_names(self, rotor: bool = False, friction: bool = False) -> list[str]:
         """Names of :meth:`parameter_vector`'s entries: m1, mx1, ..., Izz_n, Ia1.., Fv1.., Fs1.."""
-        _flag(rotor, "rotor")
-        _flag(friction, "friction")
+        checks.flag(rotor, "rotor")
+        checks.flag(friction, "friction")
         links = range(1, self.n + 1)
         names = [f"{field}{i}" for i in links for field in PARAMETER_FIELDS]
         if rotor:
@@ -165,6 +216,30 @@ class Robot(_core.Model):
         if friction:
             names += [f"Fv{i}" for i in links] + [f"Fs{i}" for i in links]
         return names
+
+    # ---- copies, pickling, equality (multiprocessing, Dask and Ray pickle what they send) -----
+    def _state(self) -> dict[str, object]:
+        """Everything that defines the robot (derived caches such as base parameters excluded)."""
+        return {
+            "dh": self.dh, "joint_types": self.joint_types, "convention": self.convention,
+            "gravity": self.gravity_vector, "params": self.params, "base": self.base,
+            "tool": self.tool, "qlim": self.qlim, "name": self.name,
+            "Ia": self.Ia, "Fv": self.Fv, "Fs": self.Fs,
+        }
+
+    def __reduce__(self) -> tuple[object, tuple[dict[str, object]]]:
+        return (_robot_from_state, (self._state(),))
+
+    def __eq__(self, other: object) -> bool:
+        """Same DH table, joint types, convention, gravity, transforms, parameters, drive terms,
+        limits and name (exact comparison)."""
+        if not isinstance(other, Robot):
+            return NotImplemented
+        mine, theirs = self._state(), other._state()
+        return all(np.array_equal(mine[k], theirs[k]) if isinstance(mine[k], np.ndarray)
+                   else mine[k] == theirs[k] for k in mine)
+
+    __hash__ = None  # type: ignore[assignment]  # parameters are settable
 
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""
@@ -201,10 +276,15 @@ class Robot(_core.Model):
             why = _core.physical_inconsistency(mass_value, inertia)
             if why:
                 raise ValueError(f"inertia: the payload is not physically possible: {why}")
+        com = _as_finite(com, "com")
         payload = _core.standard_parameters(mass_value, com, inertia)
         other = self.copy()
         params = other.params.copy()
-        params[-1] += payload
+        with np.errstate(over="ignore", invalid="ignore"):
+            params[-1] += payload
+        if not np.all(np.isfinite(params[-1])):
+            raise ValueError("com: the payload's parameters about frame n overflow "
+                             "(m |com|^2 is not a finite number); check mass and com")
         other.params = params
         return other
 
@@ -217,25 +297,19 @@ class Robot(_core.Model):
 
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
-        if isinstance(count, (bool, np.bool_)) or not isinstance(count, (int, np.integer)) or count < 0:
-            raise ValueError(f"count: expected a number of configurations >= 0, got {count!r}")
+        count = checks.count(count, "count", 0, "a number of configurations")
         rng = np.random.default_rng(seed)
         low, high = self.qlim[:, 0], self.qlim[:, 1]
         return low + (high - low) * rng.random((count, self.n))
 
 
-def _flag(value: object, name: str) -> None:
-    # SPEC section 2: a wrong type is a ValueError naming the argument as well.
-    if isinstance(value, (bool, np.bool_)):
-        return
-    raise ValueError(f"{name}: expected True or False, got {value!r}")
-
-
-def _text(value: object, name: str, expected: str) -> str:
-    # SPEC section 2: every bad argument is a ValueError naming it, wrong types included.
-    if isinstance(value, str):
-        return value
-    raise ValueError(f"{name}: expected {expected}, got {value!r}")
+def _robot_from_state(state: dict[str, object]) -> Robot:
+    """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
+    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],  # type: ignore[arg-type]
+                          state["gravity"], state["params"], state["base"], state["tool"],  # type: ignore[arg-type]
+                          state["qlim"], state["name"])  # type: ignore[arg-type]
+    robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
+    return robot
 
 
 def _default_limits(joint_types: Sequence[str]) -> NDArray[np.float64]:
@@ -245,7 +319,7 @@ def _default_limits(joint_types: Sequence[str]) -> NDArray[np.float64]:
 def _as_finite(value: ArrayLike, name: str) -> NDArray[np.float64]:
     try:
         array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{name}: expected an array of real numbers, got {value!r}") from None
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name}: contains NaN or inf")

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import signal as _sp
 from scipy.ndimage import median_filter
 
-from ._checks import positive, positive_int, real_array
+from ._checks import is_integer, positive, positive_int, real_array
 
 #: Anti-aliasing cutoff of :func:`decimate` as a fraction of the new Nyquist frequency (the value
 #: scipy.signal.decimate uses): the band kept is undistorted, the band folded back is attenuated.
@@ -49,7 +49,7 @@ def _array(x: ArrayLike, name: str, min_ndim: int = 1) -> NDArray[np.float64]:
 
 
 def _axis(x: NDArray, axis: int, name: str = "x") -> int:
-    if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)):
+    if not is_integer(axis):
         raise ValueError(f"axis: expected an integer, got {axis!r}")  # noqa: TRY004
     if not -x.ndim <= axis < x.ndim:
         raise ValueError(f"axis: {axis} is out of range for {name} with shape {x.shape}")
@@ -192,11 +192,22 @@ def differentiate(
         raise ValueError(f"x: expected at least 2 samples along axis {ax}, got {length}")
     edge_order = 2 if length >= 3 else 1
     if fs is not None:
-        return np.gradient(arr, 1.0 / positive(fs, "fs"), axis=ax, edge_order=edge_order)
+        step = 1.0 / positive(fs, "fs")
+        return _finite_result(np.gradient, arr, step, axis=ax, edge_order=edge_order)
     t = check_time(t)
     if t.size != length:
         raise ValueError(f"t: has {t.size} samples but x has {length} along axis {ax}")
-    return np.gradient(arr, t, axis=ax, edge_order=edge_order)
+    return _finite_result(np.gradient, arr, t, axis=ax, edge_order=edge_order)
+
+
+def _finite_result(gradient: Any, arr: NDArray, *args: Any, **kwargs: Any) -> NDArray:
+    # Differences of huge finite values (or tiny time steps) overflow: a ValueError naming the
+    # input, never inf/NaN with only a RuntimeWarning.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        result = gradient(arr, *args, **kwargs)
+    if not np.all(np.isfinite(result)):
+        raise ValueError("x: the derivative overflows (values too large for their time steps)")
+    return result
 
 
 # --------------------------------------------------------------------------- decimation
@@ -207,7 +218,6 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
 
     Forms::
 
-        decimate(log, factor)              -> Log (t subsampled; q, tau, qd, qdd filtered too)
         decimate(x, factor)                -> array
         decimate(x1, x2, ..., factor)      -> tuple of arrays (time along axis 0)
 
@@ -216,15 +226,13 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
     (``ANTIALIAS_FRACTION``), so content that the new rate cannot represent is removed instead of
     folding back onto low frequencies; the cutoff is relative, so arrays need no sampling rate.
     Pass ``antialias=False`` only for signals already band-limited below that (e.g. a log
-    low-passed at a lower cutoff). A time vector must not be filtered: decimate a :class:`Log`,
-    or subsample ``t[::factor]`` yourself.
+    low-passed at a lower cutoff). A time vector must not be filtered: subsample
+    ``t[::factor]`` yourself, or decimate a whole log with :func:`dynid.io.preparation.decimate_log`.
     """
-    from .io import Log  # io imports this module; a Log is only needed here
-
-    if factor is None and len(data) >= 2 and _is_integer(data[-1]):
+    if factor is None and len(data) >= 2 and is_integer(data[-1]):
         data, factor = data[:-1], data[-1]
     if factor is None:
-        raise ValueError("factor: missing; call decimate(x, factor) or decimate(log, factor)")
+        raise ValueError("factor: missing; call decimate(x, factor)")
     factor = positive_int(factor, "factor")
     order = positive_int(order, "order")
     if not data:
@@ -240,37 +248,8 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
             arr = _sosfiltfilt(arr, sos, 0, order, name)
         return np.ascontiguousarray(arr[::factor])
 
-    if len(data) == 1 and isinstance(data[0], Log):
-        log = data[0]
-        if factor == 1:
-            return log.slice(0, log.T, note="decimation by 1 (no change)")
-        fs = log.fs
-        if antialias:
-            log.check_uniform("decimate")
-        new = {
-            name: (one(getattr(log, name), name) if getattr(log, name) is not None else None)
-            for name in ("q", "tau", "qd", "qdd")
-        }
-        names = ", ".join(k for k, v in new.items() if v is not None)
-        how = (
-            f"after a zero-phase order-{order} Butterworth at {wn * fs / 2:.4g} Hz "
-            f"({ANTIALIAS_FRACTION} x the new Nyquist {fs / (2 * factor):.4g} Hz) on {names}"
-            if antialias
-            else "without anti-alias filter"
-        )
-        note = (
-            f"decimated by {factor}: one sample in {factor} kept {how}; "
-            f"{log.T} -> {len(log.t[::factor])} samples, fs {fs:.4g} -> {fs / factor:.4g} Hz"
-        )
-        return log.replace(t=log.t[::factor], **new, note=note)
-    if any(isinstance(d, Log) for d in data):
-        raise ValueError("data: decimate either one Log or arrays, not a mix")
     out = tuple(one(x, f"data[{i}]") for i, x in enumerate(data))
     return out[0] if len(out) == 1 else out
-
-
-def _is_integer(value: Any) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
 
 
 # --------------------------------------------------------------------------- masks

@@ -77,13 +77,22 @@ def paper_table(
     return "\n".join(lines)
 
 
-def validation_table(metrics: Mapping[str, NDArray[np.float64]], unit: str = "N m") -> str:
-    """Per-joint RMS, relative RMS, maximum error and R^2 as an aligned text table."""
+def validation_table(
+    metrics: Mapping[str, NDArray[np.float64]],
+    unit: str = "N m",
+    training_relative_rms: Sequence[float] | None = None,
+) -> str:
+    """Per-joint RMS, relative RMS, maximum error and R^2 as an aligned text table; with
+    ``training_relative_rms`` a last column compares with the fit on the training log."""
     n = len(metrics["rms"])
-    lines = [f"  joint   rms [{unit}]   rel. rms   max [{unit}]        R2"]
+    head = f"  joint   rms [{unit}]   rel. rms   max [{unit}]        R2"
+    lines = [head + ("   rel. rms on training log" if training_relative_rms is not None else "")]
     for j in range(n):
+        trained = (
+            f"{100 * training_relative_rms[j]:>26.2f}%" if training_relative_rms is not None else ""
+        )
         lines.append(
             f"  J{j + 1:<5}{metrics['rms'][j]:>11.4g}{100 * metrics['relative_rms'][j]:>10.2f}%"
-            f"{metrics['max_abs'][j]:>12.4g}{metrics['r2'][j]:>10.4f}"
+            f"{metrics['max_abs'][j]:>12.4g}{metrics['r2'][j]:>10.4f}{trained}"
         )
     return "\n".join(lines)

@@ -4,14 +4,16 @@ A :class:`Log` holds time, joint positions and joint torques, with velocities an
 when the recording has them. Files are NPZ or CSV, laid out as in ``docs/data.md``; the
 FloBaRoID key names of the real KUKA LWR4+ recordings (``times``, ``positions``, ...) are read as
 they are. Preparing a log for identification (filtering, differentiation, decimation, dropping
-samples) is :mod:`dynid.preparation`; :func:`prepare_log` is re-exported here.
+samples) is :mod:`dynid.io.preparation`.
 """
 
 from __future__ import annotations
 
 import csv
 import re
+import warnings
 import zipfile
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
@@ -19,8 +21,10 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import signal as sig
-from ._checks import real_array
+from .. import signal as sig
+from .._checks import count, is_integer, real_array
+from .._equality import ValueEquality
+from .columns import check_columns, matching, time_scale
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -40,7 +44,7 @@ PathLike = Union[str, Path]
 
 
 @dataclass(eq=False, repr=False)
-class Log:
+class Log(ValueEquality):
     """A measurement log: t (T,), q and tau (T, n), optional qd and qdd (T, n).
 
     ``t`` is kept as recorded (it may start anywhere, e.g. at a Unix time). ``notes`` lists, in
@@ -145,6 +149,9 @@ class Log:
                 raise ValueError(f"mask: expected a boolean array of shape ({self.T},), got {mask.shape}")
             kept = int(mask.sum())
         elif np.issubdtype(mask.dtype, np.integer) and mask.ndim == 1:
+            if mask.size and (mask.min() < 0 or mask.max() >= self.T):
+                raise ValueError(f"mask: sample indices must lie in [0, {self.T}), got "
+                                 f"{mask.min()}..{mask.max()}")
             kept = mask.size
         else:
             raise ValueError(
@@ -160,8 +167,7 @@ class Log:
               note: str | None = None) -> Log:
         """Samples start:stop (Python slice semantics, negative indices allowed)."""
         for name, value in (("start", start), ("stop", stop)):
-            if value is not None and (isinstance(value, bool)
-                                      or not isinstance(value, (int, np.integer))):
+            if value is not None and not is_integer(value):
                 raise ValueError(f"{name}: expected an integer or None, got {value!r}")
         lo, hi, _ = slice(start, stop).indices(self.T)
         if note is None:
@@ -199,11 +205,21 @@ def _check_finite(arr: NDArray, name: str, rows: NDArray | None = None) -> None:
 # --------------------------------------------------------------------------- loading
 
 
-def load_log(path: PathLike, *, skip: int = 0) -> Log:
+def load_log(
+    path: PathLike,
+    *,
+    skip: int = 0,
+    columns: Mapping[str, str] | None = None,
+    time_unit: str = "s",
+) -> Log:
     """Load a log from an ``.npz`` or ``.csv`` file (formats in ``docs/data.md``).
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
-    the LWR4+ logs skips 500). Errors name the file and what is missing or malformed.
+    the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
+    (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.io.columns`) and
+    ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count. Errors name the file
+    and what is missing or malformed; an implausible sampling rate or position range is a
+    warning that says what to check.
     """
     path = Path(path)
     if not path.is_file():
@@ -211,26 +227,85 @@ def load_log(path: PathLike, *, skip: int = 0) -> Log:
     suffix = path.suffix.lower()
     if suffix not in (".npz", ".csv"):
         raise ValueError(f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv")
-    if isinstance(skip, bool) or not isinstance(skip, (int, np.integer)) or skip < 0:
-        raise ValueError(f"skip: expected a non-negative integer, got {skip!r}")
+    skip = count(skip, "skip", 0)
+    mapping = check_columns(columns) if columns is not None else None
+    seconds = time_scale(time_unit)
     try:
-        log = _load_npz(path) if suffix == ".npz" else _load_csv(path)
+        log = _load_npz(path, mapping) if suffix == ".npz" else _load_csv(path, mapping)
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
+    if seconds != 1.0:
+        log = log.replace(t=log.t * seconds, note=f"time stamps in {time_unit}, converted to s")
     if skip:
         if skip > log.T - 2:
             raise ValueError(f"skip: {skip} leaves fewer than 2 of the {log.T} samples of {path}")
         log = log.slice(skip, None, note=f"skipped the first {skip} samples")
+    warn_implausible(log, path.name)
     return log
 
 
-def _load_npz(path: Path) -> Log:
+#: Sampling rates outside this band [Hz] are not a robot log read in the right time unit.
+PLAUSIBLE_RATE = (1.0, 100e3)
+#: |q| beyond this many radians (or metres) suggests degrees or encoder counts.
+PLAUSIBLE_POSITION = 100.0
+
+
+def warn_implausible(log: Log, what: str) -> None:
+    """Warnings for values no robot log has: a sampling rate outside PLAUSIBLE_RATE (e.g.
+    nanosecond stamps read as seconds give 2e-7 Hz and a meaningless fit) or huge positions."""
+    fs = log.fs
+    if not PLAUSIBLE_RATE[0] <= fs <= PLAUSIBLE_RATE[1]:
+        guess = "ns" if fs < 1e-3 else ("ms" if fs < 1.0 else "s")
+        warnings.warn(
+            f"{what}: t: the median sampling rate is {fs:.3g} Hz, implausible for a robot log; "
+            f"check the unit of the time stamps (time_unit / --time-unit, e.g. {guess!r})",
+            UserWarning, stacklevel=3,
+        )
+    largest = float(np.max(np.abs(log.q)))
+    if largest > PLAUSIBLE_POSITION:
+        warnings.warn(
+            f"{what}: q: positions up to {largest:.4g}; dynid expects radians (or metres): "
+            "degrees or encoder counts?", UserWarning, stacklevel=3,
+        )
+
+
+def _mapped_arrays(
+    names: Sequence[str], get: Callable[[str], NDArray], mapping: Mapping[str, str]
+) -> dict[str, NDArray]:
+    """The signals named by ``mapping`` (columns/keys or glob patterns, :mod:`.columns`): one
+    2-D array, or several 1-D ones stacked as joints in natural order; ``t`` is one 1-D array."""
+    for required in ("q", "tau"):
+        if required not in mapping:
+            raise ValueError(f"columns: {required!r} missing from the mapping {dict(mapping)}")
+    spec = {"t": "t" if "t" in names else "times", **mapping}
+    arrays: dict[str, NDArray] = {}
+    for signal, pattern in spec.items():
+        found = matching(pattern, names, signal)
+        parts = [np.asarray(get(name)) for name in found]
+        if len(parts) == 1 and (signal == "t" or parts[0].ndim == 2):
+            arrays[signal] = parts[0]
+        elif signal != "t" and all(part.ndim == 1 for part in parts):
+            arrays[signal] = np.column_stack(parts)
+        else:
+            expected = ("one time vector" if signal == "t"
+                        else "one (T, n) array or 1-D columns, one per joint")
+            raise ValueError(f"columns: {pattern!r} for {signal} matches {', '.join(found)}; "
+                             f"expected {expected}")
+    return arrays
+
+
+def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     try:
         data = np.load(path, allow_pickle=False)
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # all: "not an npz"
         raise ValueError(f"not a readable NPZ file ({type(exc).__name__}: {exc})") from None
     with data:
         found = list(data.files)
+        _check_npz_members(path)
+        if mapping is not None:
+            arrays = _mapped_arrays(found, data.__getitem__, mapping)
+            note = f"loaded from {path.name} (NPZ, columns {dict(mapping)})"
+            return Log(**arrays, source=str(path), notes=[note])
         arrays: dict[str, Any] = {}
         flobaroid = False
         for name, aliases in NPZ_KEYS.items():
@@ -256,6 +331,30 @@ def _load_npz(path: Path) -> Log:
     how = "FloBaRoID key names" if flobaroid else "dynid key names"
     note = f"loaded from {path.name} (NPZ, {how}; {', '.join(arrays)})"
     return Log(**arrays, source=str(path), notes=notes + [note])
+
+
+def _check_npz_members(path: Path) -> None:
+    """Refuse a member whose .npy header asks for more bytes than the member holds (a corrupt or
+    hostile header would otherwise make NumPy try to allocate it) or that is not .npy at all."""
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            if not info.filename.endswith(".npy"):
+                raise ValueError(f"member {info.filename!r} is not a .npy array")
+            with archive.open(info) as member:
+                try:
+                    version = np.lib.format.read_magic(member)
+                    read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                            else np.lib.format.read_array_header_2_0)
+                    shape, _, dtype = read(member)
+                except (ValueError, OSError, EOFError) as exc:
+                    raise ValueError(f"member {info.filename!r}: unreadable header ({exc})"
+                                     ) from None
+            needed = dtype.itemsize * int(np.prod(shape, dtype=object))
+            if needed > info.file_size:
+                raise ValueError(
+                    f"member {info.filename!r}: its header asks for shape {shape} "
+                    f"({needed} bytes) but the member holds {info.file_size} bytes"
+                )
 
 
 _CSV_COLUMN = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
@@ -311,9 +410,13 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
     return header, values, lines, notes
 
 
-def _load_csv(path: Path) -> Log:
+def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     header, values, lines, notes = _read_csv_table(path)
     index = {name: c for c, name in enumerate(header)}
+    if mapping is not None:
+        arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping)
+        note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
+        return Log(**arrays, source=str(path), notes=notes + [note])
     if "t" not in index:
         raise ValueError(f"missing column 't'; found columns: {', '.join(header)}")
     groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
@@ -395,7 +498,3 @@ def save_log(log: Log, path: PathLike) -> None:
     else:
         raise ValueError(f"path: unknown extension {path.suffix!r}; expected .npz or .csv")
 
-
-# Preparation builds on Log; imported last so that dynid.io.prepare_log stays where it was
-# (dynid.preparation imports Log from here).
-from .preparation import prepare_log  # noqa: F401

@@ -11,7 +11,7 @@ frequency components. Following Swevers et al. (IEEE Trans. RA 13(5), 1997), joi
 so a_il, b_il are velocity amplitudes [rad/s or m/s]. This module holds the trajectory itself
 (:class:`FourierTrajectory`), its distance to the joint limits, the rest-to-rest projection and
 the condition number that measures its excitation; choosing the coefficients is
-:mod:`dynid.excitation_optimization` (re-exported here: :func:`optimize_excitation`).
+:mod:`dynid.excitation.optimization`.
 
 The condition number is that of the stacked base regressor with every column scaled to unit
 norm (here and in the optimiser): unscaled, it would mostly measure the units of the
@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._checks import real_array
-from .base_parameters import base_parameters
-from .robot import Robot
+from .._checks import count, real_array
+from ..base_parameters import base_parameters
+from ..robot import Robot
 
 #: Default velocity and acceleration limits for every joint [rad/s, rad/s^2]: about half the
 #: KUKA LWR4+'s rated joint speeds (110-180 deg/s), gentle enough for a first experiment.
@@ -87,9 +87,14 @@ class FourierTrajectory:
         times = _finite_array(t, "t")
         if times.ndim > 1:
             raise ValueError(f"t: expected a scalar or shape (T,), got {times.shape}")
-        Bq, Bqd, Bqdd = _basis(np.atleast_1d(times), self.base_frequency, self.harmonics)
         c = np.hstack([self.a, self.b])
-        q, qd, qdd = Bq @ c.T + self.q0, Bqd @ c.T, Bqdd @ c.T
+        with np.errstate(over="ignore", invalid="ignore"):
+            Bq, Bqd, Bqdd = _basis(np.atleast_1d(times), self.base_frequency, self.harmonics)
+            q, qd, qdd = Bq @ c.T + self.q0, Bqd @ c.T, Bqdd @ c.T
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):
+            # Finite but huge coefficients or times overflow: an error, never a silent NaN.
+            raise ValueError("t: q, qd or qdd overflow at these times with this trajectory's "
+                             "coefficients (a, b, q0, base_frequency); use smaller values")
         if times.ndim == 0:
             return q[0], qd[0], qdd[0]
         return q, qd, qdd
@@ -288,11 +293,7 @@ def _finite_positive(value: object, name: str) -> float:
 
 
 def _integer(value: object, name: str, minimum: int) -> int:
-    # SPEC section 2: a wrong type is a ValueError too; True is not an integer here
-    integral = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-    if integral and value >= minimum:
-        return int(value)
-    raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return count(value, name, minimum)
 
 
 def _limit_vector(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:
@@ -310,15 +311,3 @@ def _qlim(value: ArrayLike, n: int) -> tuple[NDArray[np.float64], NDArray[np.flo
         raise ValueError(f"qlim: expected ({n}, 2) rows [lower, upper] with lower < upper")
     return limits[:, 0], limits[:, 1]
 
-
-# The optimiser builds on everything above; imported last so that the two modules can refer to
-# each other (dynid.excitation.optimize_excitation stays where it always was).
-from .excitation_optimization import (  # noqa: F401
-    CHECK_OVERSAMPLING,
-    CONSTRAINT_POINTS_PER_HARMONIC,
-    DEFAULT_POSITION_MARGIN,
-    TOLERANCE,
-    ExcitationResult,
-    _LogCondition,
-    optimize_excitation,
-)

@@ -3,7 +3,6 @@
 :func:`prepare_log` applies the steps of :mod:`dynid.signal` that the identification needs to a
 :class:`dynid.io.Log` (spike removal, zero-phase low-pass, differentiation, decimation, outlier
 and near-zero-velocity removal), each step only when asked and each recorded in ``Log.notes``.
-It is also importable from :mod:`dynid.io`, where it used to live.
 """
 
 from __future__ import annotations
@@ -13,9 +12,9 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import signal as sig
-from ._checks import positive, positive_int, real_array
-from .io import SIGNALS, Log
+from .. import signal as sig
+from .._checks import positive, positive_int, real_array
+from .log_files import SIGNALS, Log
 
 
 def prepare_log(
@@ -145,7 +144,7 @@ def prepare_log(
     # 4. decimation
     if factor > 1:
         band_limited = cutoff is not None and cutoff <= sig.ANTIALIAS_FRACTION * fs / (2 * factor)
-        log = sig.decimate(log, factor, antialias=not band_limited)
+        log = decimate_log(log, factor, antialias=not band_limited)
         if band_limited:
             log.notes[-1] += f" (already band-limited by the {cutoff:g} Hz low-pass)"
         index = index[::factor]
@@ -195,3 +194,34 @@ def prepare_log(
             raise ValueError(f"prepare_log: fewer than 2 samples would remain; {reasons}")
         log = log.select(~dropped, note=f"dropped {int(dropped.sum())} of {log.T} samples: {reasons}")
     return log
+
+
+def decimate_log(log: Log, factor: int, *, order: int = 8, antialias: bool = True) -> Log:
+    """Every ``factor``-th sample of ``log`` (from the first), q, tau, qd and qdd low-passed first
+    as :func:`dynid.signal.decimate` does (the time vector is subsampled, never filtered); the step
+    is recorded in ``notes``."""
+    factor = positive_int(factor, "factor")
+    order = positive_int(order, "order")
+    if factor == 1:
+        return log.slice(0, log.T, note="decimation by 1 (no change)")
+    fs = log.fs
+    if antialias:
+        log.check_uniform("decimate")
+    new = {
+        name: (sig.decimate(getattr(log, name), factor, order=order, antialias=antialias)
+               if getattr(log, name) is not None else None)
+        for name in SIGNALS
+    }
+    names = ", ".join(k for k, v in new.items() if v is not None)
+    cutoff = sig.ANTIALIAS_FRACTION / factor * fs / 2
+    how = (
+        f"after a zero-phase order-{order} Butterworth at {cutoff:.4g} Hz "
+        f"({sig.ANTIALIAS_FRACTION} x the new Nyquist {fs / (2 * factor):.4g} Hz) on {names}"
+        if antialias
+        else "without anti-alias filter"
+    )
+    note = (
+        f"decimated by {factor}: one sample in {factor} kept {how}; "
+        f"{log.T} -> {len(log.t[::factor])} samples, fs {fs:.4g} -> {fs / factor:.4g} Hz"
+    )
+    return log.replace(t=log.t[::factor], **new, note=note)

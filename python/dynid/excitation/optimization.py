@@ -16,8 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
-from .base_parameters import BaseParameters, base_parameters
-from .excitation import (
+from ..base_parameters import BaseParameters, base_parameters
+from ..robot import Robot
+from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,
     FourierTrajectory,
@@ -32,7 +33,6 @@ from .excitation import (
     excitation_condition_number,
     rest_to_rest,
 )
-from .robot import Robot
 
 #: Default distance kept from each joint limit, as a fraction of the joint's range.
 DEFAULT_POSITION_MARGIN = 0.02

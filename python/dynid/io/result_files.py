@@ -5,7 +5,9 @@ the model (DH table, joint types, convention, gravity, base/tool, limits), the r
 the base-parameter structure (independent columns and beta over the standard parameter names),
 the coefficients with their expressions and standard deviations, the condition number and rank,
 and the training log's preparation and per-joint fit. Non-finite numbers (a relative standard
-deviation of a coefficient that is exactly 0) are written as null.
+deviation of a coefficient that is exactly 0) are written as null. A physically consistent
+result (``identify_log(physical=True)``) also holds the identified parameters in ``model`` and
+the solver's report in ``physical``; ``load_result(...).robot`` is then the identified robot.
 """
 
 from __future__ import annotations
@@ -17,31 +19,77 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from .io import Log
-from .log_identification import LogIdentification
-from .model_files import dumps_json, model_from_dict
-from .plots import plot_residuals, plot_torques
+from .._version import dynid_version
+from ..log_identification import LogIdentification, LogValidation
+from .log_files import Log
+from .model_files import dumps_json, load_model, model_from_dict
+from .output_folder import output_folder
 
 PathLike = Union[str, Path]
 
 FORMAT = "dynid-identification"
-VERSION = 1
+#: Format version written; the loader reads versions 1 (no covariance) to VERSION.
+VERSION = 2
+#: Units of what a result holds (written into result.json for readers other than dynid).
+UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "torque": "N m",
+         "coefficients": "SI, as their expressions over the standard parameters"}
 RESULT_FILE = "result.json"
+VALIDATION_FORMAT = "dynid-validation"
+VALIDATION_FILE = "validation.json"
 
 
-def save_result(result: LogIdentification, folder: PathLike, log: Log | None = None) -> Path:
-    """Write ``folder/result.json`` and, when ``log`` is given, the plots of the fit on it."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / RESULT_FILE
-    path.write_text(dumps_json(result_to_dict(result)) + "\n")
-    if log is not None:
-        save_plots(folder, log, result.predict(log), "training log")
-    return path
+def save_result(
+    result: LogIdentification,
+    folder: PathLike,
+    log: Log | None = None,
+    plots: bool = True,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``folder/result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of
+    the fit on ``log`` (default: the training log, when the result kept it); returns the JSON
+    path. ``folder`` must be new or empty unless ``overwrite``; it is written as a whole or not
+    at all (:mod:`dynid.io.output_folder`)."""
+    log = log if log is not None else result.log
+    with output_folder(folder, overwrite) as staging:
+        (staging / RESULT_FILE).write_text(dumps_json(result_to_dict(result)) + "\n")
+        if plots and log is not None:
+            save_plots(staging, log, result.predict(log), "training log")
+    return Path(folder) / RESULT_FILE
+
+
+def save_validation(
+    validation: LogValidation,
+    folder: PathLike,
+    *,
+    result_source: str = "",
+    log_source: str = "",
+    plots: bool = True,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``folder/validation.json`` (per-joint metrics, preparation, sources) and, when
+    ``plots``, the torque and residual plots of the validation log; returns the JSON path."""
+    report = {
+        "format": VALIDATION_FORMAT,
+        "version": VERSION,
+        "dynid_version": dynid_version(),
+        "result": result_source,
+        "log": log_source,
+        "samples": validation.log.T,
+        "preparation": validation.preparation,
+        "notes": validation.log.notes,
+        "metrics": metrics_to_dict(validation.metrics),
+    }
+    with output_folder(folder, overwrite) as staging:
+        (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
+        if plots:
+            save_plots(staging, validation.log, validation.predicted, "validation log")
+    return Path(folder) / VALIDATION_FILE
 
 
 def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str) -> list[Path]:
     """``torques.png`` (measured and predicted torque per joint) and ``residuals.png``."""
+    from ..plots import plot_residuals, plot_torques  # matplotlib: imported when plotting
+
     t = log.t - log.t[0]
     name = Path(log.source).name or what
     return [
@@ -82,9 +130,11 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     ]
     training = dict(result.training)
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
-    return {
+    data = {
         "format": FORMAT,
         "version": VERSION,
+        "dynid_version": dynid_version(),
+        "units": UNITS,
         "model": result.model,
         "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
                     "method": result.method, "exclude_joints": list(result.excluded)},
@@ -92,6 +142,7 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         "rank": result.rank,
         "coefficients": coefficients,
         "training": training,
+        "covariance": _nums(result.covariance) if result.covariance is not None else None,
         "base_parameters": {
             "count": result.count,
             "parameter_names": result.parameter_names,
@@ -99,6 +150,9 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
             "beta": _nums(result.beta),
         },
     }
+    if result.physical is not None:
+        data["physical"] = result.physical
+    return data
 
 
 def result_from_dict(data: Any) -> LogIdentification:
@@ -107,6 +161,11 @@ def result_from_dict(data: Any) -> LogIdentification:
     if data.get("format") != FORMAT:
         raise ValueError(f"format: expected {FORMAT!r} (a dynid identify result), got "
                          f"{data.get('format')!r}")
+    version = data.get("version")
+    if not (isinstance(version, int) and not isinstance(version, bool) and 1 <= version <= VERSION):
+        raise ValueError(f"version: expected a format version 1..{VERSION} (written by dynid "
+                         f"{data.get('dynid_version', '?')}; this is dynid {dynid_version()}), "
+                         f"got {version!r}")
     model = _object(_get(data, "model"), "model")
     try:
         robot = model_from_dict(model)
@@ -150,6 +209,12 @@ def result_from_dict(data: Any) -> LogIdentification:
     training["metrics"] = {k: _array(v, f"training.metrics.{k}", 1, nullable=True)
                            for k, v in metrics.items()}
     method = _get(options, "method", "options")
+    physical = data.get("physical")
+    if physical is not None:
+        physical = _object(physical, "physical")
+        if not robot.is_physically_consistent():
+            raise ValueError("model: a physically consistent result whose parameters are not "
+                             "physically consistent (edited file?)")
     return LogIdentification(
         model=dict(model), rotor=flags["rotor"], friction=flags["friction"],
         offset=flags["offset"], method=str(method), parameter_names=list(names_std),
@@ -164,8 +229,19 @@ def result_from_dict(data: Any) -> LogIdentification:
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
+        covariance=_covariance(data.get("covariance"), count + (robot.n if flags["offset"] else 0)),
+        physical=physical,
         _robot=robot,
     )
+
+
+def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
+    if value is None:
+        return None
+    covariance = _array(value, "covariance", 2, nullable=True)
+    if covariance.shape != (size, size):
+        raise ValueError(f"covariance: expected shape ({size}, {size}), got {covariance.shape}")
+    return covariance
 
 
 def metrics_to_dict(metrics: dict[str, NDArray[np.float64]]) -> dict[str, list]:
@@ -229,3 +305,25 @@ def _has_bool(value: Any) -> bool:
     if isinstance(value, bool):
         return True
     return isinstance(value, list) and any(_has_bool(v) for v in value)
+
+
+def export_robot(
+    source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
+) -> Path:
+    """Write the robot of ``source`` as a URDF file (``dynid export``): ``source`` is a result
+    folder or ``result.json`` of a physically consistent identification, or anything
+    :func:`~dynid.io.model_files.load_model` reads (a built-in name, a model file, a URDF).
+    A least-squares result holds base parameters only, not a robot: a ValueError says so."""
+    path = Path(source)
+    if path.is_dir() or path.name == RESULT_FILE:
+        result = load_result(path)
+        if result.physical is None:
+            raise ValueError(
+                f"{path}: a least-squares result holds base parameters only, not a full robot; "
+                "identify with --physical (dynid identify LOG --physical) to export a model"
+            )
+        robot = result.robot
+    else:
+        robot = load_model(source)
+    robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
+    return Path(urdf)

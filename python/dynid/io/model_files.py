@@ -24,8 +24,8 @@ from typing import Any, Union
 
 import numpy as np
 
-from . import models
-from .robot import Robot
+from .. import models
+from ..robot import Robot
 
 PathLike = Union[str, Path]
 
@@ -34,6 +34,9 @@ BUILTIN_MODELS: dict[str, Callable[[], Robot]] = {
     "kuka_lwr4": models.kuka_lwr4,
     "puma560": models.puma560,
     "planar_2r": models.planar_2r,
+    "panda": models.panda,
+    "ur5": models.ur5,
+    "ur10": models.ur10,
 }
 
 FORMAT = "dynid-model"
@@ -49,9 +52,18 @@ ROW_NAMES = {
 }
 YAML_SUFFIXES = (".yaml", ".yml")
 
+#: Limits on what a file may ask for (docs/cli.md), checked before any work: a 12 KB file with
+#: 300 DH rows would otherwise keep `dynid info` computing base parameters for many minutes.
+MAX_JOINTS = 64
+MAX_FILE_BYTES = 16 * 2**20
+MAX_YAML_ALIASES = 100
+MAX_EXPANDED_VALUES = 1_000_000
+
 
 def load_model(path_or_name: PathLike) -> Robot:
-    """A built-in model (``kuka_lwr4``, ``puma560``, ``planar_2r``) or a model file (JSON/YAML).
+    """A built-in model (``kuka_lwr4``, ``puma560``, ``planar_2r``, ``panda``, ``ur5``,
+    ``ur10``), a model file (JSON/YAML) or a URDF file (``.urdf``: :meth:`Robot.from_urdf` with
+    its defaults: the whole chain from the root to the single leaf, standard DH).
 
     Raises FileNotFoundError for a missing file and ValueError naming the field that is missing
     or malformed (prefixed by the file name).
@@ -68,6 +80,10 @@ def load_model(path_or_name: PathLike) -> Robot:
             )
         raise FileNotFoundError(f"model: no such file: {path}")
     try:
+        if path.suffix.lower() == ".urdf":
+            if path.stat().st_size > MAX_FILE_BYTES:
+                raise ValueError(f"more than {MAX_FILE_BYTES} bytes: not a robot description")
+            return Robot.from_urdf(path)
         return model_from_dict(read_structured(path))
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
@@ -118,6 +134,9 @@ def model_from_dict(data: Any) -> Robot:
     rows = data["rows"]
     if not isinstance(rows, list) or not rows:
         raise ValueError(f"rows: expected a non-empty list of DH rows, got {rows!r:.60}")
+    if len(rows) > MAX_JOINTS:
+        raise ValueError(f"rows: {len(rows)} DH rows; dynid model files hold at most "
+                         f"{MAX_JOINTS} joints")
     dh = np.array([_row(row, i, convention) for i, row in enumerate(rows)])
     n = len(dh)
     name = data.get("name")
@@ -202,9 +221,13 @@ def _row(row: Any, i: int, convention: str) -> list[float]:
 
 
 def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-        raise ValueError(f"{where}: expected a finite number, got {value!r}")
-    return float(value)
+    try:
+        number = float(value) if not isinstance(value, (bool, str, bytes)) else np.nan
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond 1e308
+        number = np.nan
+    if not isinstance(value, (int, float)) or not np.isfinite(number):
+        raise ValueError(f"{where}: expected a finite number, got {value!r:.60}")
+    return number
 
 
 def _numbers(value: Any, where: str, shape: tuple[int, ...]) -> np.ndarray:
@@ -213,7 +236,7 @@ def _numbers(value: Any, where: str, shape: tuple[int, ...]) -> np.ndarray:
         if isinstance(value, (str, bytes)) or _has_bool(value):
             raise TypeError
         array = np.array(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         array = None
     if array is None or not (array.shape == shape or (shape[-1:] == (10,) and array.shape
                                                       == (shape[0] * 10,))):
@@ -240,20 +263,66 @@ def _floats(value: Any) -> Any:
 def read_structured(path: Path) -> Any:
     """The parsed content of a JSON or YAML file; ValueError with the place of a syntax error."""
     suffix = path.suffix.lower()
-    text = path.read_text()
-    if suffix in YAML_SUFFIXES:
-        yaml = _yaml(path)
-        try:
-            return yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            raise ValueError(f"not valid YAML ({exc})".replace("\n", " ")) from None
-    if suffix != ".json":
+    if suffix not in YAML_SUFFIXES and suffix != ".json":
         raise ValueError(f"unknown extension {path.suffix!r}; expected .json, .yaml or .yml")
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise ValueError(f"{size} bytes is more than a model or result file can need "
+                         f"(limit {MAX_FILE_BYTES} bytes)")
     try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise ValueError("not a text file") from None
+    try:
+        if suffix in YAML_SUFFIXES:
+            return _load_yaml(text, path)
         return json.loads(text)
     except json.JSONDecodeError as exc:
         raise ValueError(f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}"
                          ) from None
+    except RecursionError:
+        raise ValueError("nesting too deep to be a model or result file") from None
+
+
+def _load_yaml(text: str, path: Path) -> Any:
+    """YAML through PyYAML's safe loader, with at most MAX_YAML_ALIASES aliases: a few hundred
+    bytes of nested aliases (a "billion laughs" file) would otherwise expand to gigabytes."""
+    yaml = _yaml(path)
+
+    class BoundedLoader(yaml.SafeLoader):  # type: ignore[name-defined,misc]
+        aliases = 0
+
+        def compose_node(self, parent: Any, index: Any) -> Any:
+            if self.check_event(yaml.events.AliasEvent):
+                self.aliases += 1
+                if self.aliases > MAX_YAML_ALIASES:
+                    raise ValueError(f"more than {MAX_YAML_ALIASES} YAML aliases (&/*): refused")
+            return super().compose_node(parent, index)
+
+    try:
+        data = yaml.load(text, Loader=BoundedLoader)  # noqa: S506 -- a SafeLoader subclass
+    except yaml.YAMLError as exc:
+        raise ValueError(f"not valid YAML ({exc})".replace("\n", " ")) from None
+    _check_expanded_size(data)
+    return data
+
+
+def _check_expanded_size(data: Any) -> None:
+    """Aliases share one object; counted as often as they are referenced, a file's values must
+    stay below MAX_EXPANDED_VALUES (few aliases nested deeply still multiply)."""
+    budget = [MAX_EXPANDED_VALUES]
+
+    def visit(value: Any) -> None:
+        budget[0] -= 1
+        if budget[0] < 0:
+            raise ValueError(f"the YAML file expands to more than {MAX_EXPANDED_VALUES} values "
+                             "(nested aliases): refused")
+        children = value.values() if isinstance(value, dict) else value
+        if isinstance(value, (dict, list)):
+            for child in children:
+                visit(child)
+
+    visit(data)
 
 
 def _yaml(path: Path) -> Any:

@@ -1,0 +1,111 @@
+"""What each ``dynid`` command does: load its inputs, call the library, print, write."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from typing import Any
+
+
+def _steps(total: int) -> Callable[[str], None]:
+    start = time.perf_counter()
+    count = [0]
+
+    def step(text: str) -> None:
+        count[0] += 1
+        print(f"[{count[0]}/{total}] {text}  ({time.perf_counter() - start:.1f} s)", flush=True)
+
+    return step
+
+
+def log_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``load_log`` options given on the command line."""
+    from ..io.columns import parse_columns
+
+    columns = parse_columns(args.columns) if args.columns is not None else None
+    return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+
+
+def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``prepare_log`` options given on the command line."""
+    options: dict[str, Any] = {"cutoff": args.cutoff, "decimate": args.decimate}
+    if args.cutoff is not None:
+        options["order"] = args.order
+    for key, option in (("min_velocity", "min_velocity"), ("outlier_k", "outliers")):
+        if getattr(args, option, None) is not None:
+            options[key] = getattr(args, option)
+    return {k: v for k, v in options.items() if v is not None and not (k == "decimate" and v == 1)}
+
+
+def demo(args: argparse.Namespace) -> None:
+    from ..demo import run_demo
+
+    run_demo(args.output, train=args.train, validation=args.validation, seed=args.seed)
+
+
+def identify(args: argparse.Namespace) -> None:
+    from ..io.log_files import load_log
+    from ..io.model_files import load_model
+    from ..io.output_folder import check_output_path
+    from ..io.result_files import save_result
+    from ..log_identification import identify_log
+
+    check_output_path(args.output, args.overwrite)  # before the work, not after
+    if not args.physical and (args.prior is not None or args.prior_weight is not None):
+        raise ValueError("--prior, --prior-weight: only with --physical")
+    step = _steps(5)
+    log = load_log(args.log, **log_options(args))
+    step(f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
+         + (f" (first {args.skip} skipped)" if args.skip else ""))
+    robot = load_model(args.model)
+    step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
+    result = identify_log(log, robot, rotor=args.rotor, friction=args.friction,
+                          offset=args.offset, method=args.method,
+                          preparation=preparation_options(args), physical=args.physical,
+                          prior=args.prior, prior_weight=args.prior_weight)
+    new_notes = result.training["notes"][len(log.notes):]
+    step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
+    step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
+    print(result.summary(), flush=True)
+    path = save_result(result, args.output, overwrite=args.overwrite)
+    step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def validate(args: argparse.Namespace) -> None:
+    from ..io.log_files import load_log
+    from ..io.output_folder import check_output_path
+    from ..io.result_files import load_result, save_validation
+    from ..log_identification import run_validation
+    from ..validation import validation_table
+
+    check_output_path(args.output, args.overwrite)
+    step = _steps(3)
+    result = load_result(args.result)
+    log = load_log(args.log, **log_options(args))
+    validation = run_validation(result, log, preparation=preparation_options(args))
+    step(f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
+         f"log {args.log}: {validation.log.T} samples")
+    for note in validation.notes:
+        print(f"note: {note} (--cutoff)", flush=True)
+    step("predicted the torques")
+    print(validation_table(validation.metrics,
+                           training_relative_rms=result.training.get("metrics", {}).get(
+                               "relative_rms")))
+    path = save_validation(validation, args.output, result_source=str(args.result),
+                           log_source=str(args.log), overwrite=args.overwrite)
+    step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def export(args: argparse.Namespace) -> None:
+    from ..io.result_files import export_robot
+
+    path = export_robot(args.source, args.urdf, name=args.name, overwrite=args.overwrite)
+    print(f"wrote {path}", flush=True)
+
+
+def info(args: argparse.Namespace) -> None:
+    from ..io.model_files import load_model
+    from ..summary import model_summary
+
+    print(model_summary(load_model(args.model)))

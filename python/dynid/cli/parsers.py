@@ -1,0 +1,128 @@
+"""The ``dynid`` command line's arguments (docs/cli.md); each command's ``run`` is in
+:mod:`.commands`."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from . import commands
+
+DEFAULT_MODEL = "kuka_lwr4"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="dynid",
+        description="Dynamics and identification of robot arms given by DH tables or URDF.",
+    )
+    subcommands = parser.add_subparsers(dest="command", required=True)
+    demo = subcommands.add_parser(
+        "demo", help="the KUKA LWR-IV identification of Gaz et al. (ICRA 2014) on a simulated arm"
+    )
+    demo.add_argument("--output", default="dynid-demo", help="output folder (default ./dynid-demo)")
+    demo.add_argument("--train", type=int, default=1000, help="training configurations")
+    demo.add_argument("--validation", type=int, default=200, help="validation configurations")
+    demo.add_argument("--seed", type=int, default=0)
+    demo.set_defaults(run=commands.demo)
+    _add_identify(subcommands)
+    _add_validate(subcommands)
+    _add_info(subcommands)
+    _add_export(subcommands)
+    return parser
+
+
+# --------------------------------------------------------------------------- parsers
+
+
+def _add_identify(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "identify", help="identify the base parameters on a measurement log (docs/cli.md)",
+        description="Identify the base dynamic parameters of a DH model on a log (NPZ or CSV, "
+        "docs/data.md) by least squares; write result.json and PNG plots.",
+    )
+    p.add_argument("log", help="measurement log, .npz or .csv")
+    _add_model(p)
+    p.add_argument("--rotor", action="store_true", help="add the rotor inertia columns Ia")
+    p.add_argument("--friction", action="store_true",
+                   help="add viscous and Coulomb friction columns Fv, Fs")
+    p.add_argument("--offset", action="store_true",
+                   help="add a constant torque (sensor offset) per joint")
+    p.add_argument("--method", choices=("ols", "wls"), default="wls",
+                   help="ordinary or weighted (per-joint noise) least squares (default wls)")
+    p.add_argument("--physical", action="store_true",
+                   help="physically consistent fit (SDP: every link a possible rigid body, "
+                   "Ia, Fv, Fs >= 0); the result holds a full robot (docs/identification.md)")
+    p.add_argument("--prior", metavar="MODEL|URDF",
+                   help="with --physical: the model (built-in name, model file or URDF) whose "
+                   "parameters fill the directions the data cannot see")
+    p.add_argument("--prior-weight", type=float, metavar="W",
+                   help="with --prior: its weight (default 1e-5, docs/identification.md)")
+    _add_preparation(p)
+    p.add_argument("--min-velocity", type=float, metavar="V",
+                   help="drop samples where some joint has |qd| < V (friction near zero speed)")
+    p.add_argument("--outliers", type=float, metavar="K",
+                   help="drop torque spikes beyond K robust sigmas")
+    p.add_argument("--output", default="dynid-identify", metavar="DIR",
+                   help="output folder (default ./dynid-identify)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the output folder if it exists and is not empty")
+    p.set_defaults(run=commands.identify)
+
+
+def _add_validate(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "validate", help="apply a saved identification to another log",
+        description="Predict the torques of LOG with a result of `dynid identify` and report "
+        "per-joint RMS, relative RMS, maximum error and R^2; write validation.json and plots.",
+    )
+    p.add_argument("result", help="result folder of `dynid identify`, or its result.json")
+    p.add_argument("log", help="measurement log, .npz or .csv")
+    _add_preparation(p)
+    p.add_argument("--output", default="dynid-validate", metavar="DIR",
+                   help="output folder (default ./dynid-validate)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the output folder if it exists and is not empty")
+    p.set_defaults(run=commands.validate)
+
+
+def _add_info(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "info", help="show a model: DH table, parameters, base-parameter counts",
+    )
+    _add_model(p)
+    p.set_defaults(run=commands.info)
+
+
+def _add_export(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "export", help="write a model or a physically consistent result as URDF",
+        description="Write the robot of SOURCE as a URDF: SOURCE is a result folder (or its "
+        "result.json) of `dynid identify --physical`, a built-in model name, a model file or a "
+        "URDF. Least-squares results hold base parameters only and cannot be exported.",
+    )
+    p.add_argument("source", metavar="SOURCE", help="result folder/result.json, model or URDF")
+    p.add_argument("--urdf", required=True, metavar="FILE", help="the URDF file to write")
+    p.add_argument("--name", help="robot name in the URDF (default: the model's name)")
+    p.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
+    p.set_defaults(run=commands.export)
+
+
+def _add_model(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--model", default=DEFAULT_MODEL, metavar="NAME|FILE",
+                   help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
+                   f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}")
+
+
+def _add_preparation(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--skip", type=int, default=0, metavar="N",
+                   help="drop the first N samples (start-up transient)")
+    p.add_argument("--columns", metavar="MAP",
+                   help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
+                   "(glob patterns, joints in natural order; docs/data.md)")
+    p.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s",
+                   help="unit of the log's time stamps (default s)")
+    p.add_argument("--cutoff", type=float, metavar="HZ",
+                   help="zero-phase Butterworth low-pass of q, qd, qdd, tau at HZ")
+    p.add_argument("--order", type=int, default=4, help="order of that filter (default 4)")
+    p.add_argument("--decimate", type=int, default=1, metavar="K", help="keep every K-th sample")

@@ -1,0 +1,33 @@
+"""Exciting trajectories for identification (notes, "Identification experiments").
+
+- :mod:`dynid.excitation.trajectory`: the finite Fourier series (:class:`FourierTrajectory`), its
+  limits, the rest-to-rest projection and the condition number that measures its excitation;
+- :mod:`dynid.excitation.optimization`: choosing its coefficients (:func:`optimize_excitation`,
+  SciPy's SLSQP, imported when first used).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from .trajectory import FourierTrajectory, excitation_condition_number, rest_to_rest
+
+if TYPE_CHECKING:
+    from .optimization import ExcitationResult, optimize_excitation
+
+__all__ = [
+    "ExcitationResult",
+    "FourierTrajectory",
+    "excitation_condition_number",
+    "optimize_excitation",
+    "rest_to_rest",
+]
+
+
+def __getattr__(name: str) -> Any:
+    # The optimiser needs scipy.optimize (~0.3 s to import): loaded on first use only.
+    if name in ("ExcitationResult", "optimize_excitation"):
+        from . import optimization
+
+        return getattr(optimization, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

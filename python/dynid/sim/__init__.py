@@ -1,0 +1,32 @@
+"""Simulated robots: a closed-loop simulator and a virtual controller like the KUKA LWR's.
+
+- :func:`simulate` runs a robot under a controller at the controller's rate (C++ integration
+  loop, RK4 or semi-implicit Euler, zero-order hold on the torque, friction, torque noise,
+  encoder quantisation): :mod:`~dynid.sim.closed_loop`, control laws in
+  :mod:`~dynid.sim.controllers`.
+- :class:`VirtualController` reports what the LWR's interface reports (numeric M(q), g(q),
+  measured q and joint torques along a motion tracked in closed loop):
+  :mod:`~dynid.sim.virtual_controller`.
+"""
+
+from .closed_loop import Simulation, plant_friction, simulate
+from .controllers import PD, ComputedTorque, PDGravity
+from .virtual_controller import (
+    StaticReadings,
+    TorqueRecording,
+    VirtualController,
+    paper_validation_trajectory,
+)
+
+__all__ = [
+    "PD",
+    "ComputedTorque",
+    "PDGravity",
+    "Simulation",
+    "StaticReadings",
+    "TorqueRecording",
+    "VirtualController",
+    "paper_validation_trajectory",
+    "plant_friction",
+    "simulate",
+]

@@ -1,0 +1,51 @@
+"""A robot model as text: what ``dynid info`` prints (DH table, limits, transforms, parameters,
+drive terms and the base-parameter counts of SPEC section 3)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base_parameters import base_parameters
+from .robot import Robot
+
+
+def model_summary(robot: Robot) -> str:
+    """The DH table with joint limits, base/tool transforms when not the identity, the standard
+    parameters per link, the drive terms and the base-parameter counts per regressor kind."""
+    lines = [
+        f"{robot.name}: {robot.n} joints ({robot.joint_types}), {robot.convention} DH, "
+        f"gravity {np.round(robot.gravity_vector, 6).tolist()}"
+    ]
+    heads = ("a_{i-1}", "alpha_{i-1}") if robot.convention == "modified" else ("a", "alpha")
+    lines.append(f"  {'row':<4}{'type':<5}{heads[0]:>10}  {heads[1]:>16}  {'d':>10}  "
+                 f"{'theta':>10}  {'qmin':>8}  {'qmax':>8}")
+    for i, (row, kind, lim) in enumerate(zip(robot.dh, robot.joint_types, robot.qlim)):
+        alpha = f"{row[1]:.6g} ({np.degrees(row[1]):.4g}°)"
+        lines.append(f"  {i + 1:<4}{kind:<5}{row[0]:>10.6g}  {alpha:>16}  {row[2]:>10.6g}  "
+                     f"{row[3]:>10.6g}  {lim[0]:>8.4g}  {lim[1]:>8.4g}")
+    for key in ("base", "tool"):
+        value = np.asarray(getattr(robot, key))
+        if not np.array_equal(value, np.eye(4)):
+            lines.append(f"  {key}: {np.round(value, 6).tolist()}")
+    params = robot.params
+    lines.append(
+        "parameters (frame-i origin, SPEC order m mx my mz Ixx Ixy Ixz Iyy Iyz Izz); total "
+        f"mass {params[:, 0].sum():.4g} kg, physically consistent: "
+        f"{'yes' if robot.is_physically_consistent() else 'no'}"
+    )
+    for i, row in enumerate(params):
+        lines.append(f"  link {i + 1}:" + "".join(f"{v:>11.4g}" for v in row))
+    for key in ("Ia", "Fv", "Fs"):
+        lines.append(f"  {key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, key)))
+    counts = [
+        (label, base_parameters(robot, "torque", rotor=rotor, friction=friction).count)
+        for label, rotor, friction in (("rigid body", False, False), ("+ rotor", True, False),
+                                       ("+ friction", False, True),
+                                       ("+ rotor + friction", True, True))
+    ]
+    lines.append(
+        "base parameters: torque " + ", ".join(f"{c} ({label})" for label, c in counts)
+        + f"; gravity {base_parameters(robot, 'gravity').count}; inertia "
+        f"{base_parameters(robot, 'inertia').count}"
+    )
+    return "\n".join(lines)

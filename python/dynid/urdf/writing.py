@@ -1,0 +1,174 @@
+"""A DH robot written as URDF text (SPEC 6), and written to a file atomically.
+
+Links ``base_link`` (the world, massless), ``link1`` .. ``linkn`` (the DH links) and ``tool``
+(massless, at the tool transform); joints ``joint1`` .. ``jointn`` (revolute or prismatic,
+axis z) and the fixed ``tool_joint``.
+
+URDF moves a joint's child about (along) an axis through the child's origin, so URDF link i's
+frame is *joint i's frame*: z on joint i's axis, at q_i:
+
+- standard DH: frame i-1 turned by q_i (Rz(q_i), or Tz(q_i) if prismatic); DH frame i sits at
+  K_i = A_i(q=0) = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i) in it;
+- modified DH: DH frame i without its own offsets, frame i-1 times Rx(alpha_{i-1}) Tx(a_{i-1})
+  Rz(q_i); DH frame i sits at K_i = Rz(theta_i) Tz(d_i) in it (K_i = identity without offsets).
+
+Every constant rotation between consecutive frames is then Rz(theta) Rx(alpha), whose URDF
+``rpy`` is exactly (alpha, 0, theta): no decomposition near a singularity. Only the base and
+tool rotations are decomposed into rpy (general rotations).
+
+Each link's inertial is written about its centre of mass with an ``<origin>`` whose axes are
+those of DH frame i (rpy of K_i), so the inertia tensor is the robot's, unrotated. The rotor
+inertia Ia has no URDF field: it is written in a comment inside the joint,
+``<!-- dynid: Ia="..." ... -->``, which :meth:`dynid.Robot.from_urdf` reads back and every other
+parser ignores.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import _core
+
+Array = NDArray[np.float64]
+
+
+def urdf_text(robot: Any, name: str = "robot") -> str:
+    """The URDF of ``robot`` (a :class:`dynid.Robot`) as text. ValueError naming the first link
+    that is not physically consistent (URDF consumers need m > 0 and a positive definite inertia
+    that satisfies the triangle inequalities)."""
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f"name: expected a non-empty robot name, got {name!r}")
+    links = [_physical(robot.params[i], i) for i in range(robot.n)]
+    dh = np.asarray(robot.dh, dtype=float)
+    standard = robot.convention == "standard"
+    root = ET.Element("robot", name=name)
+    root.append(ET.Comment(
+        f" Written by dynid from a {robot.n}-joint {robot.convention}-DH model. Link i's frame "
+        "is joint i's frame (z on its axis); the inertial origins give DH frame i's axes. "
+        "Effort and velocity limits are not part of a dynid model (written as 0). "))
+    ET.SubElement(root, "link", name="base_link")
+    parent_to_joint = robot.base @ (np.eye(4) if standard else _rx_tx(dh[0]))
+    for i in range(robot.n):
+        a, alpha, d, theta = dh[i]
+        offset = _dh_offset(a, alpha, d, theta, standard)  # DH frame i in URDF link i's frame
+        mass, com, inertia = links[i]
+        link = ET.SubElement(root, "link", name=f"link{i + 1}")
+        inertial = ET.SubElement(link, "inertial")
+        ET.SubElement(inertial, "origin", xyz=_vector(offset[:3, :3] @ com + offset[:3, 3]),
+                      rpy=_vector(rpy(offset[:3, :3])))
+        ET.SubElement(inertial, "mass", value=_number(mass))
+        ET.SubElement(inertial, "inertia", **{
+            key: _number(inertia[r, c]) for key, (r, c) in
+            (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
+             ("iyz", (1, 2)), ("izz", (2, 2)))})
+        kind = "prismatic" if robot.joint_types[i] == "P" else "revolute"
+        joint = ET.SubElement(root, "joint", name=f"joint{i + 1}", type=kind)
+        joint.append(ET.Comment(
+            f' dynid: Ia="{_number(robot.Ia[i])}" (reflected rotor inertia [kg m^2], '
+            "added to M[i, i]; URDF has no field for it) "))
+        ET.SubElement(joint, "parent", link="base_link" if i == 0 else f"link{i}")
+        ET.SubElement(joint, "child", link=f"link{i + 1}")
+        ET.SubElement(joint, "origin", xyz=_vector(parent_to_joint[:3, 3]),
+                      rpy=_vector(rpy(parent_to_joint[:3, :3])))
+        ET.SubElement(joint, "axis", xyz="0 0 1")
+        lower, upper = robot.qlim[i]
+        ET.SubElement(joint, "limit", lower=_number(lower), upper=_number(upper), effort="0",
+                      velocity="0")
+        ET.SubElement(joint, "dynamics", damping=_number(robot.Fv[i]),
+                      friction=_number(robot.Fs[i]))
+        parent_to_joint = offset if standard or i + 1 == robot.n else offset @ _rx_tx(dh[i + 1])
+    ET.SubElement(root, "link", name="tool")
+    tool_joint = ET.SubElement(root, "joint", name="tool_joint", type="fixed")
+    ET.SubElement(tool_joint, "parent", link=f"link{robot.n}")
+    ET.SubElement(tool_joint, "child", link="tool")
+    tool = parent_to_joint @ robot.tool
+    ET.SubElement(tool_joint, "origin", xyz=_vector(tool[:3, 3]), rpy=_vector(rpy(tool[:3, :3])))
+    ET.indent(root, space="  ")
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def write_urdf(text: str, path: str | Path, overwrite: bool = False) -> Path:
+    """Write ``text`` to ``path`` through a temporary file and a rename (the file is whole or
+    absent). An existing file is a ValueError unless ``overwrite``."""
+    if not isinstance(overwrite, bool):
+        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+            f"overwrite: expected True or False, got {overwrite!r}")
+    if not isinstance(path, (str, Path)) or not str(path).strip():
+        raise ValueError(f"path: expected a file path, got {path!r}")
+    target = Path(path)
+    if target.is_dir():
+        raise ValueError(f"path: {target} is a folder")
+    if target.exists() and not overwrite:
+        raise ValueError(f"path: {target} exists; pass overwrite=True (--overwrite) to replace it")
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, target)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def rpy(rotation: Array) -> Array:
+    """URDF roll, pitch, yaw of a rotation matrix (R = Rz(yaw) Ry(pitch) Rx(roll))."""
+    cos_pitch = float(np.hypot(rotation[0, 0], rotation[1, 0]))
+    pitch = float(np.arctan2(-rotation[2, 0], cos_pitch))
+    if cos_pitch < 1e-10:  # gimbal lock: roll and yaw share an axis; put it all in roll
+        return np.array([np.arctan2(-rotation[1, 2], rotation[1, 1]), pitch, 0.0])
+    return np.array([np.arctan2(rotation[2, 1], rotation[2, 2]), pitch,
+                     np.arctan2(rotation[1, 0], rotation[0, 0])])
+
+
+def _physical(params: Array, i: int) -> tuple[float, Array, Array]:
+    mass = float(params[0])
+    com = np.asarray(params[1:4]) / mass if mass > 0.0 else np.zeros(3)
+    about_origin = np.array([[params[4], params[5], params[6]],
+                             [params[5], params[7], params[8]],
+                             [params[6], params[8], params[9]]])
+    inertia = about_origin - mass * ((com @ com) * np.eye(3) - np.outer(com, com))
+    why = f"mass {mass} is not positive" if not mass > 0.0 else _core.physical_inconsistency(
+        mass, inertia)
+    if why:
+        raise ValueError(f"robot: link {i + 1} is not physically consistent ({why}); a URDF link "
+                         "needs m > 0 and a positive definite inertia about its centre of mass "
+                         "that satisfies the triangle inequalities")
+    return mass, com, inertia
+
+
+def _dh_offset(a: float, alpha: float, d: float, theta: float, standard: bool) -> Array:
+    """K_i: DH frame i in URDF link i's frame (see the module docstring)."""
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    pose = np.eye(4)
+    pose[:3, :3] = [[ct, -st, 0.0], [st, ct, 0.0], [0.0, 0.0, 1.0]]
+    pose[2, 3] = d
+    if standard:
+        pose[:3, :3] = pose[:3, :3] @ [[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]]
+        pose[:2, 3] = a * ct, a * st
+    return pose
+
+
+def _rx_tx(row: Array) -> Array:
+    """Rx(alpha_{i-1}) Tx(a_{i-1}) of a modified row."""
+    a, alpha = row[0], row[1]
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0, a], [0.0, ca, -sa, 0.0], [0.0, sa, ca, 0.0],
+                     [0.0, 0.0, 0.0, 1.0]])
+
+
+def _number(value: float) -> str:
+    return repr(float(value) + 0.0)  # shortest text reading back to the same double; no -0.0
+
+
+def _vector(values: Array) -> str:
+    return " ".join(_number(v) for v in values)
