@@ -1,6 +1,7 @@
 // Selection of the batch kernels at load time (detail/batch.hpp). __builtin_cpu_supports also
 // checks that the operating system saves the wide registers (XGETBV), so a listed path runs.
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -53,6 +54,17 @@ std::atomic<const LaneKernels*>& selected() {
 }
 
 }  // namespace
+
+void sincos_many(const double* x, double* s, double* c, int count) {
+  static const SinCos widest = [] {
+    const LaneKernels* best = nullptr;
+    for (const char* path : kPaths)
+      if (cpu_supports(path)) best = kernels_of(path);
+    return best ? best->sincos : nullptr;
+  }();
+  if (widest) return widest(x, s, c, count);
+  for (int k = 0; k < count; ++k) s[k] = std::sin(x[k]), c[k] = std::cos(x[k]);
+}
 
 const LaneKernels* batch_kernels() { return selected().load(std::memory_order_relaxed); }
 

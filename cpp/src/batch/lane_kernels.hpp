@@ -65,6 +65,17 @@ inline void sincos_lanes(V x, V& s, V& c) {
   }
 }
 
+// sin and cos of `count` angles, W at a time (for the joint transforms of single calls).
+void sincos_many(const double* x, double* s, double* c, int count) {
+  for (int k = 0; k < count; k += W) {
+    const int m = count - k < W ? count - k : W;
+    V v = {}, sv, cv;
+    for (int l = 0; l < m; ++l) v[l] = x[k + l];
+    sincos_lanes(v, sv, cv);
+    for (int l = 0; l < m; ++l) s[k + l] = sv[l], c[k + l] = cv[l];
+  }
+}
+
 // ------------------------------------------------------------------------------ 3-vectors
 struct V3 {
   V x, y, z;

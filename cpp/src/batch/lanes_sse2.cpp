@@ -8,5 +8,6 @@
 namespace dynid::detail {
 const LaneKernels lanes_sse2 = {"sse2", 2, &lanes_sse2_impl::rnea, &lanes_sse2_impl::gravity,
                                 &lanes_sse2_impl::mass_matrix,
-                                &lanes_sse2_impl::regressor};
+                                &lanes_sse2_impl::regressor,
+                                &lanes_sse2_impl::sincos_many};
 }  // namespace dynid::detail

@@ -25,6 +25,10 @@ void set_batch_isa(const std::string& isa);
 // The paths this CPU and build can run, "scalar" first.
 std::vector<std::string> supported_batch_isas();
 
+// sin and cos of `count` angles by the widest vectorised sincos the CPU runs (whatever the batch
+// path forced), or libm's when there is none; a few ulp (tests/test_batch_lanes.py).
+void sincos_many(const double* x, double* s, double* c, int count);
+
 // The model as plain numbers; `joints` is the storage the result points into.
 BatchModel batch_model(const Model& model, std::vector<BatchJoint>& joints);
 

@@ -37,6 +37,9 @@ using BatchRegressor = long (*)(const BatchModel&, const double* q, const double
                                 const double* qdd, int rotor, int friction, const int* columns,
                                 int C, double* Y, long T);
 
+// sin and cos of `count` angles (the lane kernels' vectorised sincos, a few ulp).
+using SinCos = void (*)(const double* x, double* s, double* c, int count);
+
 struct LaneKernels {
   const char* name;  // "sse2", "avx2", "avx512"
   int lanes;         // samples per SIMD vector
@@ -44,6 +47,7 @@ struct LaneKernels {
   BatchGravity gravity;
   BatchMassMatrix mass_matrix;
   BatchRegressor regressor;
+  SinCos sincos;
 };
 
 // Defined in cpp/src/batch/lanes_*.cpp (the AVX ones on x86-64 only).
