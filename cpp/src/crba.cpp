@@ -79,15 +79,26 @@ void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B) {
   // ... and is carried inwards frame by frame. Every column that has reached J_{j+1} crosses
   // X[j+1] in the same sweep: the columns' chains are independent, so interleaving them keeps
   // the floating-point units busy instead of waiting on one chain's latency.
+  // Written out in scalars (JointTransform::rotate_to_parent, then mu += p x f): GCC's
+  // vectorisation of the Eigen form packed pairs through the stack and stalled on store
+  // forwarding, which cost more than the arithmetic.
   for (int j = n - 1; j >= 1; --j) {
     const JointTransform& X = ws.X[j + 1];
+    const double ct = X.ct, st = X.st, ca = X.ca, sa = X.sa;
+    const double px = X.p.x(), py = X.p.y(), pz = X.p.z();
     const bool revolute = model.joint(j - 1).revolute;
     for (int i = j + 1; i <= n; ++i) {
-      Vector3& f = ws.f[i];
-      Vector3& mu = ws.mu[i];
-      f = X.rotate_to_parent(f);
-      mu = X.rotate_to_parent(mu) + X.p.cross(f);
-      const double bji = revolute ? mu.z() : f.z();
+      double* f = ws.f[i].data();
+      double* mu = ws.mu[i].data();
+      const double f1 = st * f[0] + ct * f[1];
+      const double F0 = ct * f[0] - st * f[1], F1 = ca * f1 - sa * f[2], F2 = sa * f1 + ca * f[2];
+      const double m1 = st * mu[0] + ct * mu[1];
+      const double M0 = ct * mu[0] - st * mu[1] + (py * F2 - pz * F1);
+      const double M1 = ca * m1 - sa * mu[2] + (pz * F0 - px * F2);
+      const double M2 = sa * m1 + ca * mu[2] + (px * F1 - py * F0);
+      f[0] = F0, f[1] = F1, f[2] = F2;
+      mu[0] = M0, mu[1] = M1, mu[2] = M2;
+      const double bji = revolute ? M2 : F2;
       B(j - 1, i - 1) = bji;
       B(i - 1, j - 1) = bji;
     }
