@@ -66,7 +66,7 @@ def test_lanes_equal_single_calls_for_every_batch_size(lane_path: str, case: str
     assert_same(robot.rnea(q, qd, qdd), per_sample(robot.rnea, q, qd, qdd))
     assert_same(robot.gravity(q), per_sample(robot.gravity, q))
     assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
-    for rotor, friction in ((False, False), (True, True)):
+    for rotor, friction in ((False, False), (True, False), (False, True), (True, True)):
         assert_same(
             robot.regressor(q, qd, qdd, rotor=rotor, friction=friction),
             per_sample(lambda *x: robot.regressor(*x, rotor=rotor, friction=friction), q, qd, qdd),
