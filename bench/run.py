@@ -22,10 +22,11 @@ from pathlib import Path
 from typing import Any
 
 import cpp_level  # sibling modules: bench/ is sys.path[0] when run as a script
-import dynid
 import numpy as np
 import pinocchio_arm
 import python_level
+
+import dynid
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -38,6 +39,7 @@ TARGETS: dict[tuple[str, str], tuple[str, float]] = {
     ("C++", "coriolis_matrix"): ("ratio", 0.5),
     ("C++", "regressor"): ("ratio", 0.5),
     ("C++", "forward_dynamics"): ("ratio", 1.0),
+    ("C++", "rnea_derivatives"): ("ratio", 0.7),  # issue 11
     ("Python", "rnea"): ("ratio", 0.6),
     ("Python", "mass_matrix"): ("ratio", 0.6),
     ("Python", "gravity"): ("ratio", 0.6),
@@ -55,6 +57,7 @@ PINOCCHIO_NAMES = {
     ("C++", "coriolis_matrix"): "computeCoriolisMatrix",
     ("C++", "regressor"): "computeJointTorqueRegressor",
     ("C++", "forward_dynamics"): "aba",
+    ("C++", "rnea_derivatives"): "computeRNEADerivatives",
     ("Python", "rnea"): "pin.rnea",
     ("Python", "mass_matrix"): "pin.crba",
     ("Python", "gravity"): "pin.computeGeneralizedGravity",

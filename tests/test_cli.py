@@ -1,4 +1,5 @@
-"""`dynid identify`, `dynid validate`, `dynid info`: in process through main(), once as a process."""
+"""`dynid identify`, `dynid validate`, `dynid info`: in process through main(), once as a
+process."""
 
 from __future__ import annotations
 
@@ -6,9 +7,10 @@ import json
 import subprocess
 import sys
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.cli import main
 from dynid.io import save_log
 from dynid.io.model_files import save_model
@@ -90,7 +92,7 @@ ERRORS = [
 ]
 
 
-@pytest.mark.parametrize("argv, message", ERRORS)
+@pytest.mark.parametrize(("argv", "message"), ERRORS)
 def test_errors_exit_2_with_one_line(files, capsys, argv, message):
     assert main([a.format(d=files) for a in argv]) == 2
     err = capsys.readouterr().err
@@ -107,3 +109,24 @@ def test_as_a_process(files):
     assert done.returncode == 2
     assert done.stderr.startswith("dynid identify: error: ") and done.stderr.count("\n") == 1
     assert "missing key 'tau'" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_identify_position_torque(files, tmp_path, capsys):
+    """--position-torque: the 2R arm's exact torques plus 0.3 sin q2 - 0.2 cos q2 on joint 2.
+    Joint 1's columns are gravity on this vertical-plane arm (left out, said so); the result
+    holds ks2, kc2 to 1e-9 and records the joint in result.json."""
+    arm = _arm()
+    log = fourier_log(arm, 1, seconds=4.0)
+    tau = log.tau.copy()
+    tau[:, 1] += 0.3 * np.sin(log.q[:, 1]) - 0.2 * np.cos(log.q[:, 1])
+    save_log(dynid.io.Log(t=log.t, q=log.q, tau=tau, qd=log.qd, qdd=log.qdd), tmp_path / "p.npz")
+    out = tmp_path / "ident"
+    assert main(["identify", str(tmp_path / "p.npz"), "--model", str(files / "arm.json"),
+                 "--friction", "--position-torque", "--method", "ols", "--output", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "not on joint(s) 1" in printed and "kc2" in printed
+    result = load_result(out)
+    assert result.names[-2:] == ["ks2", "kc2"] and result.position_joints == (1,)
+    np.testing.assert_allclose(result.theta[-2:], [0.3, -0.2], rtol=0, atol=1e-9)
+    options = json.loads((out / "result.json").read_text())["options"]
+    assert options["position_torque_joints"] == [2]

@@ -4,10 +4,11 @@ refused, options are checked."""
 
 from __future__ import annotations
 
-import dynid
-import dynid.cli
 import numpy as np
 import pytest
+
+import dynid
+import dynid.cli
 
 LOG = "tests/data/measurements_1.npz"
 PRIOR = "tests/data/urdf/kuka_lwr4.urdf"
@@ -67,3 +68,18 @@ def test_prior_only_with_physical(tmp_path, capsys) -> None:
     status = dynid.cli.main(["identify", LOG, "--prior", PRIOR, "--output", str(tmp_path / "o")])
     assert status == 2
     assert "--prior, --prior-weight: only with --physical" in capsys.readouterr().err
+
+
+def test_residual_command(tmp_path, capsys) -> None:
+    """`dynid residual` writes the residual of residual_from_log (the same numbers) and a plot."""
+    from dynid.observer import residual_from_log
+
+    out = tmp_path / "residual"
+    status = dynid.cli.main(["residual", "kuka_lwr4", LOG, "--skip", "4000", "--gain", "10",
+                             "--threshold", "1", "--output", str(out)])
+    assert status == 0
+    saved = np.load(out / "residual.npz")
+    expected = residual_from_log(dynid.models.kuka_lwr4(), dynid.load_log(LOG, skip=4000), 10.0)
+    assert np.array_equal(saved["r"], expected.r)
+    assert (out / "residual.png").stat().st_size > 0
+    assert "J7" in capsys.readouterr().out

@@ -18,9 +18,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.sim import (
     PD,
     ComputedTorque,
@@ -415,18 +416,16 @@ def test_bad_arguments_raise_value_error_naming_them(lwr, kwargs, name):
 
 
 def test_the_documented_example_runs():
-    # The python example of the simulation section (docs/uses_simulation_part.md, or docs/uses.md
-    # once merged there) runs as written; its mismatched computed torque lags by more than 1 cm.
+    # The python example of the simulation section of docs/uses.md runs as written; its
+    # mismatched computed torque lags by more than 1 cm.
     section = "## Closed-loop simulation at the controller rate"
-    docs = [REPO / "docs" / "uses.md", REPO / "docs" / "uses_simulation_part.md"]
-    text = next(d.read_text(encoding="utf-8") for d in docs
-                if d.is_file() and section in d.read_text(encoding="utf-8"))
+    text = (REPO / "docs" / "uses.md").read_text(encoding="utf-8")
     body = text.split(section, 1)[1].split("\n## ", 1)[0]
     codes = re.findall(r"^```python\n(.*?)^```", body, flags=re.MULTILINE | re.DOTALL)
     assert codes
     for code in codes:
         namespace: dict = {"__name__": "__docs__"}
-        exec(compile(code, "docs", "exec"), namespace)  # noqa: S102 -- the doc's own code
+        exec(compile(code, "docs", "exec"), namespace)
     assert np.abs(namespace["eq33"](namespace["run"].t)[0] - namespace["run"].q).max() > 0.01
 
 

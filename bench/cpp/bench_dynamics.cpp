@@ -3,7 +3,7 @@
 //   bench_dynamics MODEL_FILE [--runs R] [--calls C] [--states S] [--only FUNCTION]
 //
 // --only times one function (rnea, crba, gravity, coriolis_matrix, regressor,
-// forward_dynamics), e.g. under `perf record` to see where its time goes.
+// forward_dynamics, rnea_derivatives), e.g. under `perf record` to see where its time goes.
 //
 // MODEL_FILE is written by bench/run.py from dynid.models.kuka_lwr4() (format in
 // bench_inputs.hpp). For each function: S distinct states drawn once with a fixed seed, cycled;
@@ -201,7 +201,8 @@ class DynidSide {
  public:
   explicit DynidSide(const dynid::Model& m, const States& s)
       : model(m), states(s), ws(m), tau(m.n()), g(m.n()), qdd(m.n()), M(m.n(), m.n()),
-        S(m.n(), m.n()), Y(m.n(), dynid::regressor_columns(m.n(), false, false)) {}
+        S(m.n(), m.n()), Y(m.n(), dynid::regressor_columns(m.n(), false, false)),
+        dtau_dq(m.n(), m.n()), dtau_dqd(m.n(), m.n()) {}
 
   double rnea(int k) {
     dynid::rnea(model, ws, states.q.col(k), states.qd.col(k), states.qdd.col(k), tau);
@@ -227,6 +228,10 @@ class DynidSide {
     dynid::forward_dynamics(model, ws, states.q.col(k), states.qd.col(k), states.tau.col(k), qdd);
     return qdd[0];
   }
+  double rnea_derivatives(int k) {
+    dynid::rnea_derivatives(model, ws, states.q.col(k), states.qd.col(k), states.qdd.col(k), dtau_dq, dtau_dqd);
+    return dtau_dq(0, 0);
+  }
 
   const dynid::Model& model;
   const States& states;
@@ -237,6 +242,7 @@ class DynidSide {
   Output<&dynid::crba> M;
   Output<&dynid::coriolis_matrix> S;
   Output<&dynid::regressor> Y;
+  MatrixXd dtau_dq, dtau_dqd;
 };
 
 #ifdef DYNID_BENCH_WITH_PINOCCHIO
@@ -264,6 +270,9 @@ std::map<std::string, double> compare(DynidSide& d, bench::PinocchioSide& p) {
     note("regressor", d.Y - p.Y() * T);
     d.forward_dynamics(k), p.forward_dynamics(k);
     note("forward_dynamics", d.qdd - p.qdd());
+    d.rnea_derivatives(k), p.rnea_derivatives(k);
+    note("rnea_derivatives", d.dtau_dq - p.dtau_dq());
+    note("rnea_derivatives", d.dtau_dqd - p.dtau_dqd());  // the bench arm has Fv = 0
   }
   return worst;
 }
@@ -285,6 +294,7 @@ std::array<std::map<std::string, Stat>, sizeof...(Side)> time_all(const Plan& pl
   record("coriolis_matrix", [](auto& side, int k) { return side.coriolis_matrix(k); });
   record("regressor", [](auto& side, int k) { return side.regressor(k); });
   record("forward_dynamics", [](auto& side, int k) { return side.forward_dynamics(k); });
+  record("rnea_derivatives", [](auto& side, int k) { return side.rnea_derivatives(k); });
   if (us[0].empty()) throw std::runtime_error("--only: no function named " + plan.only);
   return us;
 }

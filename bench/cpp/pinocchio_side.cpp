@@ -20,6 +20,7 @@
 #include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/crba.hpp"
 #include "pinocchio/algorithm/regressor.hpp"
+#include "pinocchio/algorithm/rnea-derivatives.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
 #include "pinocchio/multibody.hpp"
 
@@ -172,12 +173,23 @@ double PinocchioSide::forward_dynamics(int k) {
   return pinocchio::aba(p.model, p.data, p.states.q.col(k), p.states.qd.col(k), p.states.tau.col(k))[0];
 }
 
+// Pinocchio's routine also fills dtau/da (= M, upper triangle) on the way; dynid's leaves M to
+// crba. Timed as the library offers it: the one call a user makes for the derivatives.
+double PinocchioSide::rnea_derivatives(int k) {
+  Impl& p = *impl_;
+  pinocchio::computeRNEADerivatives(p.model, p.data, p.states.q.col(k), p.states.qd.col(k),
+                                    p.states.qdd.col(k));
+  return p.data.dtau_dq(0, 0);
+}
+
 const Eigen::VectorXd& PinocchioSide::tau() const { return impl_->data.tau; }
 const Eigen::MatrixXd& PinocchioSide::M() const { return impl_->data.M; }
 const Eigen::VectorXd& PinocchioSide::g() const { return impl_->data.g; }
 const Eigen::MatrixXd& PinocchioSide::C() const { return impl_->data.C; }
 const Eigen::MatrixXd& PinocchioSide::Y() const { return impl_->data.jointTorqueRegressor; }
 const Eigen::VectorXd& PinocchioSide::qdd() const { return impl_->data.ddq; }
+const PinocchioSide::RowMatrixXd& PinocchioSide::dtau_dq() const { return impl_->data.dtau_dq; }
+const PinocchioSide::RowMatrixXd& PinocchioSide::dtau_dqd() const { return impl_->data.dtau_dv; }
 
 Eigen::MatrixXd PinocchioSide::regressor_map() const {
   const int n = impl_->arm.n();

@@ -23,6 +23,7 @@ class PinocchioSide {
   double coriolis_matrix(int k);
   double regressor(int k);
   double forward_dynamics(int k);  // aba on (q, qd, tau)
+  double rnea_derivatives(int k);  // computeRNEADerivatives (dtau/dq, dtau/dv, dtau/da)
 
   // The last results (Pinocchio's Data members).
   const Eigen::VectorXd& tau() const;
@@ -31,6 +32,10 @@ class PinocchioSide {
   const Eigen::MatrixXd& C() const;
   const Eigen::MatrixXd& Y() const;
   const Eigen::VectorXd& qdd() const;
+  // Pinocchio stores the derivatives row-major (Data::RowMatrixXs).
+  using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMatrixXd& dtau_dq() const;
+  const RowMatrixXd& dtau_dqd() const;
 
   // blockdiag(T_1..T_n), T_i mapping link i's dynid parameters (SPEC order, about DH frame i)
   // to Pinocchio's (its order, about joint frame i): Y_dynid == Y_pinocchio * regressor_map().

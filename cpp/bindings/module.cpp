@@ -8,12 +8,15 @@
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 #include "simulator.hpp"
+#include "text_signatures.hpp"
+#include "uses.hpp"
 
 namespace py = pybind11;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
+  dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
   dynid::binding::bind_batch(m);
   dynid::binding::bind_fast_calls(m);
   dynid::binding::bind_recursive_least_squares(m);
@@ -46,4 +49,5 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("mass"), py::arg("inertia_com"),
       "Why a body of this mass and inertia about its centre of mass cannot exist ('' if it can).");
+  dynid::binding::add_text_signatures(m);  // last: after every function is defined
 }

@@ -26,6 +26,7 @@ Workspace::Workspace(const Model& model)
       zeros(VectorX::Zero(n)),
       M(MatrixX::Zero(n, n)),
       bias(VectorX::Zero(n)),
-      cholesky(n) {}
+      cholesky(n),
+      derivatives(n) {}
 
 }  // namespace dynid

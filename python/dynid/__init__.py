@@ -25,7 +25,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from ._core import get_threads, set_threads
+from ._core import MomentumObserver, get_threads, set_threads
 from ._version import __version__
 
 # Imported here, not lazily: the submodule of the same name would otherwise shadow the function
@@ -98,10 +98,63 @@ _LAZY = {
     "scale_motion": ".time_scaling",
     "scale_torques": ".time_scaling",
     "scaling_for_torque_limits": ".time_scaling",
+    "observer": ".observer",
 }
 
-__all__ = sorted([*_LAZY, "BaseParameters", "Robot", "base_parameters", "get_threads", "set_threads",
-                  "__version__"])
+# Literal (not computed) so that linters and type checkers see the public names; a test checks
+# that it lists every name of _LAZY.
+__all__ = [
+    "BaseParameters",
+    "DynamicBounds",
+    "FourierTrajectory",
+    "IdentifiedModel",
+    "LeastSquaresResult",
+    "Log",
+    "LogIdentification",
+    "MomentumObserver",
+    "PayloadEstimate",
+    "PhysicalIdentificationError",
+    "PhysicalResult",
+    "RankDeficientError",
+    "RecursiveLeastSquares",
+    "Robot",
+    "VirtualController",
+    "__version__",
+    "base_parameters",
+    "dynamic_bounds",
+    "estimate_payload",
+    "excitation",
+    "get_cmake_dir",
+    "get_include",
+    "get_threads",
+    "identify_from_controller",
+    "identify_log",
+    "io",
+    "least_squares",
+    "load_log",
+    "load_model",
+    "load_result",
+    "models",
+    "observer",
+    "optimize_excitation",
+    "payload_from_identified",
+    "payload_mass_estimates",
+    "physical_least_squares",
+    "prepare_log",
+    "save_log",
+    "save_model",
+    "save_result",
+    "scale_motion",
+    "scale_time",
+    "scale_torques",
+    "scaling_for_torque_limits",
+    "set_threads",
+    "signal",
+    "sim",
+    "simulate",
+    "validate_log",
+    "validation",
+]
 
 
 def __getattr__(name: str) -> Any:

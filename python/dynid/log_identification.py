@@ -9,18 +9,22 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
    rotor (Ia) and friction (Fv, Fs) columns when asked, and reduced to the base parameters
    (``dynid.base_parameters``);
 3. optionally one constant column per joint is appended: a torque offset (sensor bias; with
-   Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-);
+   Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-); and, optionally, a
+   position torque ks_j sin q_j + kc_j cos q_j per joint (``dynid.position_torque``: a
+   once-per-turn torque of the joint's sensor, gear or cables; only on the joints where it is
+   structurally identifiable);
 4. the stacked system is solved by OLS or WLS (``dynid.streaming``: the regressor chunk by
    chunk into triangular factors, the solver of ``dynid.identify.least_squares``);
 5. with ``physical=True``, the standard parameters are then estimated by the physically
    consistent semidefinite programme (``dynid.physical.physical_least_squares``: same columns,
-   same WLS weights, the offsets unconstrained, optionally a prior model), and the result carries
+   same WLS weights, the offsets and position torques unconstrained, optionally a prior model),
+   and the result carries
    that robot (``result.robot``, saved with the result) and its base values as ``theta``.
 
 The result predicts torques on any log (``predict``), is checked on another log
-(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result` (JSON with everything needed
-to apply it again, including the model's DH table, plus PNG plots) and loaded back by
-:func:`dynid.load_result`.
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result`
+(JSON with everything needed to apply it again, including the model's DH table, plus PNG plots)
+and loaded back by :func:`dynid.load_result`.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from .io.log_files import Log
 from .io.model_files import load_model, model_from_dict, model_to_dict
 from .io.preparation import prepare_log
 from .physical import physical_least_squares
+from .position_torque import position_columns, position_names, position_torque_joints
 from .robot import Robot
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
@@ -65,7 +70,8 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 @dataclass(eq=False)
 class LogIdentification(ValueEquality):
-    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
+    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see
+    :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
     (``expressions`` gives each as a combination of the standard ones), then the offsets.
@@ -100,6 +106,8 @@ class LogIdentification(ValueEquality):
     covariance: NDArray[np.float64] | None = None
     training: dict[str, Any] = field(default_factory=dict)
     physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
+    #: joints (0-based) with a position torque ks_j sin q_j + kc_j cos q_j (``position_torque``)
+    position_joints: tuple[int, ...] = ()
     #: the prepared training log (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
     _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
@@ -123,8 +131,14 @@ class LogIdentification(ValueEquality):
             self._robot = model_from_dict(self.model)
         return self._robot
 
+    @property
+    def position_torque(self) -> bool:
+        """Whether the model has position-torque columns (on ``position_joints``)."""
+        return bool(self.position_joints)
+
     def regressor(self, q: Any, qd: Any, qdd: Any) -> NDArray[np.float64]:
-        """The (T, n, p) regressor of ``theta``: base columns, then the offset columns."""
+        """The (T, n, p) regressor of ``theta``: base columns, then the offset columns, then the
+        position-torque columns (sin q_j, cos q_j of each of ``position_joints``)."""
         robot = self.robot
         total = robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
         if total != len(self.parameter_names):
@@ -141,6 +155,9 @@ class LogIdentification(ValueEquality):
         if self.offset:
             ones = np.broadcast_to(np.eye(self.n), (Y.shape[0], self.n, self.n))
             Y = np.concatenate([Y, ones], axis=2)
+        if self.position_joints:
+            q2 = np.asarray(q, dtype=float).reshape(Y.shape[0], self.n)
+            Y = np.concatenate([Y, position_columns(q2, self.position_joints)], axis=2)
         return Y
 
     def predict(self, log: Log) -> NDArray[np.float64]:
@@ -154,8 +171,12 @@ class LogIdentification(ValueEquality):
     def summary(self) -> str:
         """Coefficients (value, std, relative std, expression), condition number and rank, and
         the per-joint fit on the training log, as text."""
-        options = ", ".join(k for k in ("rotor", "friction", "offset") if getattr(self, k))
+        options = ", ".join(k.replace("_", " ") for k in ("rotor", "friction", "offset",
+                                                           "position_torque") if getattr(self, k))
         offsets = f" + {self.n} offsets" if self.offset else ""
+        if self.position_joints:
+            offsets += (f" + position torque on joint(s) "
+                        f"{', '.join(str(j + 1) for j in self.position_joints)}")
         columns = "rigid body" + (f", {options}" if options else "")
         model = (f"model: {self.model.get('name') or '?'} ({self.n} joints, "
                  f"{self.model['convention']} DH); columns: {columns}")
@@ -197,13 +218,19 @@ def identify_log(
     physical: bool = False,
     prior: Robot | PathLike | None = None,
     prior_weight: float | None = None,
+    position_torque: bool = False,
 ) -> LogIdentification:
     """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
 
     ``preparation``: options of :func:`dynid.io.prepare_log` (cutoff, order, differentiate,
     decimate, min_velocity, outlier_k) applied first; qd and qdd are computed from q when the log
     lacks them. ``rotor``/``friction`` add the Ia and Fv, Fs columns, ``offset`` one constant
-    torque per joint. ``method`` is "ols" or "wls" (weighted by each joint's noise level, the
+    torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
+    these two columns are structurally identifiable next to the others
+    (:func:`dynid.position_torque.position_torque_joints`; the joints left out are named in
+    ``training["notes"]``): a joint-side torque that depends on the joint's own position (torque
+    sensor or gear ripple once per turn, cable or spring stiffness; docs/identification.md).
+    ``method`` is "ols" or "wls" (weighted by each joint's noise level, the
     default: the joints' torques differ by two orders of magnitude). ``exclude_joints`` (0-based)
     leaves those joints' rows out of the fit. Raises ValueError (RankDeficientError) when the log
     does not excite every base parameter.
@@ -220,15 +247,17 @@ def identify_log(
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if not isinstance(robot, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"robot: expected a dynid.Robot, got {type(robot).__name__}"
         )
     if not isinstance(physical, (bool, np.bool_)):
         raise ValueError(f"physical: expected True or False, got {physical!r}")
+    if not isinstance(position_torque, (bool, np.bool_)):
+        raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
     if not physical and (prior is not None or prior_weight is not None):
         raise ValueError("prior: a prior (and prior_weight) needs physical=True")
     prior_robot = _prior_model(prior) if prior is not None else None
@@ -241,13 +270,20 @@ def identify_log(
     if offset:
         names += [f"{OFFSET_NAME}{j}" for j in range(1, robot.n + 1)]
         expressions += [f"torque offset of joint {j}" for j in range(1, robot.n + 1)]
+    joints, left_out = ((), ())
+    if position_torque:
+        joints, left_out = position_torque_joints(robot, bool(rotor), bool(friction),
+                                                  bool(offset))
+        more_names, more_expressions = position_names(joints)
+        names += more_names
+        expressions += more_expressions
     result = LogIdentification(
         model=model_to_dict(robot), rotor=bool(rotor), friction=bool(friction),
         offset=bool(offset), method=method, parameter_names=list(base.parameter_names),
         independent=base.independent.copy(), beta=base.beta.copy(), names=names,
         expressions=expressions, theta=np.zeros(len(names)), std=np.zeros(len(names)),
         relative_std=np.zeros(len(names)), condition_number=np.nan, rank=0, log=prepared,
-        _robot=robot,
+        position_joints=joints, _robot=robot,
     )
     # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
     # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
@@ -275,7 +311,7 @@ def identify_log(
         "duration_s": prepared.duration,
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
-        "notes": list(prepared.notes),
+        "notes": list(prepared.notes) + _position_notes(left_out),
         "metrics": error_metrics(prepared.tau, np.concatenate(
             [result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]) @ result.theta
              for c in chunks])),
@@ -287,12 +323,15 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
               prior: Robot | None, prior_weight: float, source: Any) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one."""
     robot, n = result.robot, result.n
+    assert log.qd is not None and log.qdd is not None  # the prepared log (_with_derivatives)
     Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
     if Y.ndim == 2:
         Y = Y[None]
-    extra = n if result.offset else 0
-    if extra:
+    extra = (n if result.offset else 0) + 2 * len(result.position_joints)
+    if result.offset:
         Y = np.concatenate([Y, np.broadcast_to(np.eye(n), (Y.shape[0], n, n))], axis=2)
+    if result.position_joints:
+        Y = np.concatenate([Y, position_columns(log.q, result.position_joints)], axis=2)
     weights = np.ones(n)
     kept = [j for j in range(n) if j not in result.excluded]
     usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
@@ -319,6 +358,14 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
         "projected_links": [i + 1 for i in fit.projected],
         "min_pseudo_inertia_eigenvalues": fit.min_eigenvalues.tolist(),
     }
+
+
+def _position_notes(left_out: tuple[int, ...]) -> list[str]:
+    if not left_out:
+        return []
+    joints = ", ".join(str(j + 1) for j in left_out)
+    return [f"position torque: not on joint(s) {joints}, where sin q, cos q are combinations of "
+            "the rigid-body columns (gravity) and cannot be told apart from them"]
 
 
 def _prior_model(prior: Any) -> Robot:
@@ -397,7 +444,7 @@ def _plain(value: Any) -> Any:
 
 def _with_derivatives(log: Log, n: int, name: str) -> Log:
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if log.n != n:

@@ -10,12 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from . import _core
+from . import _core, linearization, operational_space
 
 PARAMETER_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
 
@@ -26,7 +27,8 @@ class Robot(_core.Model):
     Build one with :meth:`Robot.from_dh` or take one from :mod:`dynid.models`. The dynamics
     methods (``rnea``, ``mass_matrix``, ``gravity``, ``coriolis``, ``coriolis_matrix``,
     ``friction``, ``forward_dynamics``, ``kinetic_energy``, ``potential_energy``, ``fkine``,
-    ``jacobian``) accept one sample (n,) or T samples (T, n).
+    ``jacobian``, and SPEC section 8's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
+    ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
     """
 
     def __init__(
@@ -79,12 +81,13 @@ class Robot(_core.Model):
         name
             A label for printing.
         """
+        expected = "dh: expected shape (n, 4) with rows [a, alpha, d, theta], got"
         try:
             shape = np.shape(dh)
         except ValueError:
-            shape = "a ragged sequence"
+            raise ValueError(f"{expected} a ragged sequence") from None
         if isinstance(dh, str) or len(shape) != 2:
-            raise ValueError(f"dh: expected shape (n, 4) with rows [a, alpha, d, theta], got {shape}")
+            raise ValueError(f"{expected} {shape}")
         n = shape[0]
         if joint_types is None:
             joint_types = "R" * n
@@ -218,7 +221,7 @@ class Robot(_core.Model):
         return names
 
     # ---- copies, pickling, equality (multiprocessing, Dask and Ray pickle what they send) -----
-    def _state(self) -> dict[str, object]:
+    def _state(self) -> dict[str, Any]:
         """Everything that defines the robot (derived caches such as base parameters excluded)."""
         return {
             "dh": self.dh, "joint_types": self.joint_types, "convention": self.convention,
@@ -227,7 +230,7 @@ class Robot(_core.Model):
             "Ia": self.Ia, "Fv": self.Fv, "Fs": self.Fs,
         }
 
-    def __reduce__(self) -> tuple[object, tuple[dict[str, object]]]:
+    def __reduce__(self) -> tuple[object, tuple[dict[str, Any]]]:
         return (_robot_from_state, (self._state(),))
 
     def __eq__(self, other: object) -> bool:
@@ -239,7 +242,8 @@ class Robot(_core.Model):
         return all(np.array_equal(mine[k], theirs[k]) if isinstance(mine[k], np.ndarray)
                    else mine[k] == theirs[k] for k in mine)
 
-    __hash__ = None  # type: ignore[assignment]  # parameters are settable
+    # Unhashable (parameters are settable); mypy objects to None in place of the inherited method.
+    __hash__ = None  # type: ignore[assignment]
 
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""
@@ -295,6 +299,30 @@ class Robot(_core.Model):
         other.Ia = other.Fv = other.Fs = np.zeros(self.n)
         return other
 
+    # ---- uses of the model (SPEC section 8) ---------------------------------------------------
+    def linearize(
+        self, q: ArrayLike, qd: ArrayLike | None = None, qdd: ArrayLike | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(A, B) of the dynamics linearized at (q, qd, qdd), x = (q, qd), u = tau (notes
+        p. 44-47): (2n, 2n), (2n, n), or (T, 2n, 2n), (T, 2n, n). qd, qdd default to zeros (an
+        equilibrium). See :mod:`dynid.linearization`."""
+        return linearization.linearize(self, q, qd, qdd)
+
+    def cartesian_inertia(
+        self, q: ArrayLike, rows: str | Sequence[int] | None = None
+    ) -> NDArray[np.float64]:
+        """Operational-space inertia (J M^-1 J^T)^-1 of the tool point, (6, 6) or (T, 6, 6);
+        ``rows`` selects task rows ("position", "orientation" or indices). ValueError naming
+        ``q`` at a singular configuration. See :mod:`dynid.operational_space`."""
+        return operational_space.cartesian_inertia(self, q, rows)
+
+    def cartesian_dynamics(
+        self, q: ArrayLike, qd: ArrayLike, rows: str | Sequence[int] | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(Lam, mu, p) with Lam xdd + mu + p = F, xdd = J qdd + Jdot qd (Khatib):
+        mu = Lam (J M^-1 c - Jdot qd), p = Lam J M^-1 g. See :mod:`dynid.operational_space`."""
+        return operational_space.cartesian_dynamics(self, q, qd, rows)
+
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
         count = checks.count(count, "count", 0, "a number of configurations")
@@ -303,11 +331,11 @@ class Robot(_core.Model):
         return low + (high - low) * rng.random((count, self.n))
 
 
-def _robot_from_state(state: dict[str, object]) -> Robot:
+def _robot_from_state(state: dict[str, Any]) -> Robot:
     """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
-    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],  # type: ignore[arg-type]
-                          state["gravity"], state["params"], state["base"], state["tool"],  # type: ignore[arg-type]
-                          state["qlim"], state["name"])  # type: ignore[arg-type]
+    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],
+                          state["gravity"], state["params"], state["base"], state["tool"],
+                          state["qlim"], state["name"])
     robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
     return robot
 

@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <vector>
 
+#include "dynid/detail/derivative_buffers.hpp"
 #include "dynid/joint_transform.hpp"
 #include "dynid/model.hpp"
 #include "dynid/rigid_body.hpp"
@@ -58,6 +59,9 @@ struct Workspace {
   MatrixX M;
   VectorX bias;
   Eigen::LLT<MatrixX> cholesky;
+
+  // Analytic derivatives (rnea_derivatives.cpp).
+  detail::DerivativeBuffers derivatives;
 };
 
 }  // namespace dynid

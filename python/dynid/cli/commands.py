@@ -63,7 +63,8 @@ def identify(args: argparse.Namespace) -> None:
     result = identify_log(log, robot, rotor=args.rotor, friction=args.friction,
                           offset=args.offset, method=args.method,
                           preparation=preparation_options(args), physical=args.physical,
-                          prior=args.prior, prior_weight=args.prior_weight)
+                          prior=args.prior, prior_weight=args.prior_weight,
+                          position_torque=args.position_torque)
     new_notes = result.training["notes"][len(log.notes):]
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
@@ -102,6 +103,26 @@ def export(args: argparse.Namespace) -> None:
 
     path = export_robot(args.source, args.urdf, name=args.name, overwrite=args.overwrite)
     print(f"wrote {path}", flush=True)
+
+
+def residual(args: argparse.Namespace) -> None:
+    from ..io.log_files import load_log
+    from ..io.output_folder import check_output_path, output_folder
+    from ..io.result_files import load_model_or_result
+    from ..observer import plot_residual, residual_from_log, save_residual
+
+    check_output_path(args.output, args.overwrite)
+    model = load_model_or_result(args.model)
+    log = load_log(args.log, **log_options(args))
+    result = residual_from_log(model, log, args.gain)
+    with output_folder(args.output, args.overwrite) as staging:
+        save_residual(result, staging / "residual.npz")
+        plot_residual(result, staging / "residual.png", threshold=args.threshold)
+    print(f"momentum observer, gain {args.gain:g} 1/s, {log.T} samples at dt {result.dt:.4g} s")
+    print("  joint   rms [N m]   max |r| [N m]")
+    for j, (rms, largest) in enumerate(zip(result.rms, result.max_abs)):
+        print(f"  J{j + 1:<5}{rms:>11.4g}{largest:>16.4g}")
+    print(f"wrote {args.output}/residual.npz, {args.output}/residual.png", flush=True)
 
 
 def info(args: argparse.Namespace) -> None:

@@ -29,6 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_validate(subcommands)
     _add_info(subcommands)
     _add_export(subcommands)
+    _add_residual(subcommands)
     return parser
 
 
@@ -48,6 +49,10 @@ def _add_identify(subcommands: Any) -> None:
                    help="add viscous and Coulomb friction columns Fv, Fs")
     p.add_argument("--offset", action="store_true",
                    help="add a constant torque (sensor offset) per joint")
+    p.add_argument("--position-torque", action="store_true",
+                   help="add a torque ks_j sin q_j + kc_j cos q_j per joint (sensor/gear ripple "
+                   "once per turn, cable or spring stiffness), on the joints where it is "
+                   "distinguishable from gravity (docs/identification.md)")
     p.add_argument("--method", choices=("ols", "wls"), default="wls",
                    help="ordinary or weighted (per-joint noise) least squares (default wls)")
     p.add_argument("--physical", action="store_true",
@@ -106,6 +111,32 @@ def _add_export(subcommands: Any) -> None:
     p.add_argument("--name", help="robot name in the URDF (default: the model's name)")
     p.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
     p.set_defaults(run=commands.export)
+
+
+def _add_residual(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "residual", help="collision residual (momentum observer) of a model along a log",
+        description="Run the generalized-momentum observer (De Luca; docs/uses.md) of MODEL over "
+        "LOG: r tracks the external joint torques, zero (to the model error) without contact. "
+        "Writes residual.npz (t, r, gain, dt, rms, max_abs) and residual.png.",
+    )
+    p.add_argument("model", metavar="MODEL",
+                   help="result folder/result.json of `dynid identify`, a built-in model, a "
+                   "model file or a URDF")
+    p.add_argument("log", help="measurement log, .npz or .csv")
+    p.add_argument("--gain", type=float, default=20.0,
+                   help="observer gain K_O [1/s], the inverse time constant (default 20)")
+    p.add_argument("--threshold", type=float, metavar="T",
+                   help="draw +-T [N m] in the plot (a collision threshold)")
+    p.add_argument("--skip", type=int, default=0, metavar="N", help="drop the first N samples")
+    p.add_argument("--columns", metavar="MAP", help="columns/keys of a foreign log (docs/data.md)")
+    p.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s",
+                   help="unit of the log's time stamps (default s)")
+    p.add_argument("--output", default="dynid-residual", metavar="DIR",
+                   help="output folder (default ./dynid-residual)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the output folder if it exists and is not empty")
+    p.set_defaults(run=commands.residual)
 
 
 def _add_model(p: argparse.ArgumentParser) -> None:

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from .._version import dynid_version
 from ..log_identification import LogIdentification, LogValidation
+from ..robot import Robot
 from .log_files import Log
 from .model_files import dumps_json, load_model, model_from_dict
 from .output_folder import output_folder
@@ -137,7 +138,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         "units": UNITS,
         "model": result.model,
         "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
-                    "method": result.method, "exclude_joints": list(result.excluded)},
+                    "method": result.method, "exclude_joints": list(result.excluded),
+                    "position_torque_joints": [j + 1 for j in result.position_joints]},
         "condition_number": _num(result.condition_number),
         "rank": result.rank,
         "coefficients": coefficients,
@@ -175,7 +177,7 @@ def result_from_dict(data: Any) -> LogIdentification:
     flags = {k: _get(options, k, "options") for k in ("rotor", "friction", "offset")}
     for key, value in flags.items():
         if not isinstance(value, bool):
-            raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+            raise ValueError(
                 f"options.{key}: expected true or false, got {value!r}"
             )
     base = _object(_get(data, "base_parameters"), "base_parameters")
@@ -195,8 +197,9 @@ def result_from_dict(data: Any) -> LogIdentification:
     if beta.shape != (count, len(expected)):
         raise ValueError(f"base_parameters.beta: expected shape {(count, len(expected))}, "
                          f"got {beta.shape}")
+    position_joints = _position_joints(options.get("position_torque_joints", []), robot.n)
+    p = count + (robot.n if flags["offset"] else 0) + 2 * len(position_joints)
     rows = _get(data, "coefficients")
-    p = count + (robot.n if flags["offset"] else 0)
     if not isinstance(rows, list) or len(rows) != p:
         raise ValueError(f"coefficients: expected a list of {p} entries")
     records = [_object(row, f"coefficients[{k}]") for k, row in enumerate(rows)]
@@ -229,10 +232,21 @@ def result_from_dict(data: Any) -> LogIdentification:
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
-        covariance=_covariance(data.get("covariance"), count + (robot.n if flags["offset"] else 0)),
-        physical=physical,
+        covariance=_covariance(data.get("covariance"), p),
+        physical=physical, position_joints=position_joints,
         _robot=robot,
     )
+
+
+def _position_joints(value: Any, n: int) -> tuple[int, ...]:
+    """options.position_torque_joints (1-based, increasing; absent in older files: none) as
+    0-based joints."""
+    if not (isinstance(value, list) and all(isinstance(j, int) and not isinstance(j, bool)
+                                            for j in value)
+            and all(1 <= j <= n for j in value) and value == sorted(set(value))):
+        raise ValueError(f"options.position_torque_joints: expected increasing joint numbers "
+                         f"1..{n}, got {value!r}")
+    return tuple(j - 1 for j in value)
 
 
 def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
@@ -266,7 +280,7 @@ def _nums(value: Any) -> Any:
 
 def _object(value: Any, where: str) -> dict[str, Any]:
     if not isinstance(value, dict):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"{where}: expected an object, got {type(value).__name__}"
         )
     return dict(value)
@@ -307,6 +321,15 @@ def _has_bool(value: Any) -> bool:
     return isinstance(value, list) and any(_has_bool(v) for v in value)
 
 
+def load_model_or_result(source: PathLike) -> Robot | LogIdentification:
+    """A result folder or ``result.json`` as a :class:`LogIdentification`, anything else as
+    :func:`~dynid.io.model_files.load_model` reads it (built-in name, model file, URDF)."""
+    path = Path(source)
+    if path.is_dir() or path.name == RESULT_FILE:
+        return load_result(path)
+    return load_model(source)
+
+
 def export_robot(
     source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
 ) -> Path:
@@ -314,16 +337,16 @@ def export_robot(
     folder or ``result.json`` of a physically consistent identification, or anything
     :func:`~dynid.io.model_files.load_model` reads (a built-in name, a model file, a URDF).
     A least-squares result holds base parameters only, not a robot: a ValueError says so."""
-    path = Path(source)
-    if path.is_dir() or path.name == RESULT_FILE:
-        result = load_result(path)
+    loaded = load_model_or_result(source)
+    if isinstance(loaded, LogIdentification):
+        result = loaded
         if result.physical is None:
             raise ValueError(
-                f"{path}: a least-squares result holds base parameters only, not a full robot; "
+                f"{source}: a least-squares result holds base parameters only, not a full robot; "
                 "identify with --physical (dynid identify LOG --physical) to export a model"
             )
         robot = result.robot
     else:
-        robot = load_model(source)
+        robot = loaded
     robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
     return Path(urdf)

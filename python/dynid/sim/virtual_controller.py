@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .. import _checks as checks
 from .._checks import real_array
 from ..robot import Robot
 from .closed_loop import Simulation, plant_friction, simulate
@@ -108,6 +109,7 @@ class VirtualController:
         encoder_counts: float | None = None,
         seed: int | None = 0,
     ) -> None:
+        checks.robot(robot)
         for name, value in (
             ("model_noise", model_noise),
             ("torque_noise", torque_noise),

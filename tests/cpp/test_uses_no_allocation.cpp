@@ -1,0 +1,122 @@
+// Proof that the uses of SPEC section 8 never touch the heap per call: MomentumObserver::update,
+// rnea_derivatives and jacobian_dot, 10^4 calls each on a 7-joint arm (standard DH, one
+// prismatic joint, base, tool, drive terms), with every operator new and (on glibc) malloc
+// counted (cpp/examples/allocation_counter.hpp). Also checks that a badly sized argument is a
+// std::invalid_argument whose message starts with the argument's name.
+// Exit status 1 on an allocation, 2 on a missing or wrong error, 3 if the counters miss a probe.
+//
+// Build (tests/test_momentum_observer.py does this and runs it):
+//   g++ -O1 -std=c++17 -I cpp/include -I cpp/examples -I <eigen3>
+//       tests/cpp/test_uses_no_allocation.cpp cpp/src/*.cpp
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dynid/dynid.hpp"
+
+#include "allocation_counter.hpp"  // cpp/examples/
+
+namespace {
+
+dynid::Model make_arm() {
+  const int n = 7;
+  std::vector<dynid::DHRow> rows(n);
+  for (int i = 0; i < n; ++i) {
+    rows[i].a = 0.05 * i;
+    rows[i].alpha = (i % 2 ? -1.0 : 1.0) * 1.5707963267948966;
+    rows[i].d = 0.1 + 0.02 * i;
+    rows[i].theta = 0.1 * i;
+    rows[i].type = i == 2 ? dynid::JointType::Prismatic : dynid::JointType::Revolute;
+  }
+  dynid::Matrix4 base = dynid::Matrix4::Identity(), tool = dynid::Matrix4::Identity();
+  base(0, 3) = 0.2;
+  tool(2, 3) = 0.1;
+  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base, tool);
+  for (int i = 0; i < n; ++i) {
+    dynid::Matrix3 inertia = dynid::Matrix3::Identity() * (0.02 + 0.001 * i);
+    model.set_link(i, dynid::RigidBodyParameters::from_physical(2.0 - 0.2 * i,
+                                                                dynid::Vector3(0.01, -0.02, 0.05), inertia));
+  }
+  model.set_rotor_inertia(dynid::VectorX::Constant(n, 0.1));
+  model.set_viscous_friction(dynid::VectorX::Constant(n, 0.5));
+  model.set_coulomb_friction(dynid::VectorX::Constant(n, 0.3));
+  return model;
+}
+
+// Runs call() and checks it throws std::invalid_argument starting with "name:".
+template <class Call>
+bool names_argument(const char* name, Call call) {
+  try {
+    call();
+  } catch (const std::invalid_argument& e) {
+    if (std::string(e.what()).rfind(std::string(name) + ":", 0) == 0) return true;
+    std::printf("expected an error naming %s, got: %s\n", name, e.what());
+    return false;
+  }
+  std::printf("expected std::invalid_argument naming %s, nothing thrown\n", name);
+  return false;
+}
+
+}  // namespace
+
+int main() {
+  const dynid::Model model = make_arm();
+  const int n = model.n();
+  dynid::Workspace ws(model);
+  dynid::MomentumObserver observer(model, 25.0, 1e-3);
+  dynid::VectorX q(n), qd(n), qdd(n), tau(n), r(n);
+  dynid::MatrixX dq(n, n), dqd(n, n), Jdot(6, n);
+
+  counting = true;
+  {
+    dynid::VectorX probe(n);
+    std::vector<double> probe_new(n);
+    probe.setZero();
+    probe_new[0] = probe[0];
+  }
+  counting = false;
+  if (allocations < 2) {
+    std::printf("allocation counter broken: %ld of 2 probe allocations seen\n", allocations);
+    return 3;
+  }
+  allocations = 0;
+
+  double sink = 0.0;
+  counting = true;
+  for (int k = 0; k < 10000; ++k) {
+    const double t = 1e-3 * k;
+    for (int i = 0; i < n; ++i) {
+      q[i] = 0.5 * std::sin(0.7 * t + i);
+      qd[i] = 0.35 * std::cos(0.7 * t + i);
+      qdd[i] = -0.245 * std::sin(0.7 * t + i);
+    }
+    dynid::rnea(model, ws, q, qd, qdd, tau);  // the measured torque: the model's own, no contact
+    observer.update(q, qd, tau, r);
+    dynid::rnea_derivatives(model, ws, q, qd, qdd, dq, dqd);
+    dynid::jacobian_dot(model, ws, q, qd, Jdot);
+    sink += r[0] + dq(0, 0) + dqd(n - 1, 0) + Jdot(0, 0);
+  }
+  counting = false;
+  std::printf("allocations_during_calls=%ld\n", allocations);
+  std::printf("max_abs_residual_without_contact=%.3e\n", observer.residual().cwiseAbs().maxCoeff());
+  if (allocations != 0 || !std::isfinite(sink)) return 1;
+
+  dynid::MatrixX wrong(n, n + 1), wrong_J(5, n);
+  dynid::VectorX short_v(n - 1);
+  bool ok = true;
+  ok &= names_argument("qd", [&] { dynid::rnea_derivatives(model, ws, q, short_v, qdd, dq, dqd); });
+  ok &= names_argument("qdd", [&] { dynid::rnea_derivatives(model, ws, q, qd, short_v, dq, dqd); });
+  ok &= names_argument("dtau_dq", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, wrong, dqd); });
+  ok &= names_argument("dtau_dqd", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, dq, wrong); });
+  ok &= names_argument("q", [&] { dynid::rnea_derivatives(model, ws, short_v, qd, qdd, dq, dqd); });
+  ok &= names_argument("Jdot", [&] { dynid::jacobian_dot(model, ws, q, qd, wrong_J); });
+  ok &= names_argument("qd", [&] { dynid::jacobian_dot(model, ws, q, short_v, Jdot); });
+  ok &= names_argument("tau", [&] { observer.update(q, qd, short_v, r); });
+  ok &= names_argument("r", [&] { observer.update(q, qd, tau, short_v); });
+  ok &= names_argument("gain", [&] { dynid::MomentumObserver(model, 0.0, 1e-3); });
+  ok &= names_argument("gain", [&] { dynid::MomentumObserver(model, short_v, 1e-3); });
+  ok &= names_argument("dt", [&] { dynid::MomentumObserver(model, 1.0, -1e-3); });
+  return ok ? 0 : 2;
+}
