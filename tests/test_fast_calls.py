@@ -106,3 +106,13 @@ def test_fast_path_keeps_no_references() -> None:
         robot.gravity(s["q"])
     assert [sys.getrefcount(s[k]) for k in CALLS["rnea"]] == before
     assert "Joint torques" in (type(robot).rnea.__doc__ or "")
+
+
+@pytest.mark.parametrize("call", sorted(CALLS))
+def test_fast_methods_keep_the_signature_and_docstring(call: str) -> None:
+    import inspect
+
+    robot, _ = setup()
+    fast, full = getattr(robot, call), getattr(robot, f"_{call}_full")
+    assert inspect.signature(fast) == inspect.signature(full)
+    assert fast.__doc__ == full.__doc__

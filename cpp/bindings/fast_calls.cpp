@@ -218,7 +218,19 @@ void bind_fast_calls(py::module_& m) {
   for (int k = 0; k < kMethods; ++k) {
     PyMethodDef& def = g_methods[k];
     py::object original = cls.attr(def.ml_name);  // the pybind11 method (a plain function)
-    docs[k] = py::str(original.attr("__doc__"));
+    // The C function's own docstring: with the "name(params)\n--\n\n" line add_text_signatures
+    // put there, so inspect.signature works on the fast method too.
+    PyObject* function = PyInstanceMethod_Check(original.ptr())
+                             ? PyInstanceMethod_GET_FUNCTION(original.ptr())
+                             : original.ptr();
+    const char* doc = PyCFunction_Check(function)
+                          ? reinterpret_cast<PyCFunctionObject*>(function)->m_ml->ml_doc
+                          : nullptr;
+    docs[k] = doc ? std::string(doc) : std::string(py::str(original.attr("__doc__")));
+    // A builtin method's text signature marks the bound argument "$self" (inspect drops it).
+    const std::string plain = std::string(def.ml_name) + "(self";
+    if (docs[k].rfind(plain, 0) == 0 && docs[k].find("\n--\n\n") != std::string::npos)
+      docs[k].insert(plain.size() - 4, "$");
     def.ml_doc = docs[k].c_str();
     g_full[k] = original.release().ptr();  // kept for the module's lifetime
     PyObject* descriptor = PyDescr_NewMethod(reinterpret_cast<PyTypeObject*>(cls.ptr()), &def);
