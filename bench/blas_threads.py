@@ -44,8 +44,10 @@ def main() -> None:
         ),
     }
     threads = {lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"}
-    print(f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, default BLAS threads "
-          f"{threads}, load average {os.getloadavg()[0]:.1f}")
+    print(
+        f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, default BLAS threads "
+        f"{threads}, load average {os.getloadavg()[0]:.1f}"
+    )
     print(f"{'case':<24} {'default ms':>10} {'capped ms':>10} {'ratio':>6}")
     for name, (free, capped) in cases.items():
         times: dict[str, list[float]] = {"free": [], "capped": []}

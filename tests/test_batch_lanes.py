@@ -1,7 +1,8 @@
 """The SIMD batch kernels (samples in vector lanes, one translation unit per instruction set,
 chosen at load time) against the scalar reference kernels, on every path this CPU can run.
 
-A batch of T samples on a lane path (rnea, gravity, mass matrix, regressor) must equal T single calls (which always run the scalar
+A batch of T samples on a lane path (rnea, gravity, mass matrix, regressor) must equal T single
+calls (which always run the scalar
 kernels, themselves tested against Pinocchio and closed forms elsewhere) to 1e-12 relative to
 the sample's largest entry (at least 1): the lane kernels do the same arithmetic, in another
 order only where FMA contracts it, and compute sin/cos with their own reduction and polynomial.
@@ -11,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import ARM_CASES, make_arm, random_state
 
 import dynid
+from conftest import ARM_CASES, make_arm, random_state
 from dynid import _core
 
 LANE_PATHS = [isa for isa in _core._supported_batch_isas() if isa != "scalar"]
@@ -57,7 +58,9 @@ def test_the_machine_runs_a_lane_path() -> None:
 
 @pytest.mark.parametrize("case", ARM_CASES)
 @pytest.mark.parametrize("count", list(range(1, 18)))
-def test_lanes_equal_single_calls_for_every_batch_size(lane_path: str, case: str, count: int) -> None:
+def test_lanes_equal_single_calls_for_every_batch_size(
+    lane_path: str, case: str, count: int
+) -> None:
     # T = 1..17 covers partial vectors of every lane count (2, 4, 8) and several whole ones;
     # the arms cover both conventions, prismatic joints, base, tool, gravity, Ia, Fv, Fs.
     robot = make_arm(case).robot()
@@ -69,12 +72,16 @@ def test_lanes_equal_single_calls_for_every_batch_size(lane_path: str, case: str
     for rotor, friction in ((False, False), (True, False), (False, True), (True, True)):
         assert_same(
             robot.regressor(q, qd, qdd, rotor=rotor, friction=friction),
-            per_sample(lambda *x: robot.regressor(*x, rotor=rotor, friction=friction), q, qd, qdd),
+            per_sample(
+                lambda *x, r=rotor, f=friction: robot.regressor(*x, rotor=r, friction=f), q, qd, qdd
+            ),
         )
     columns = np.array([5, 0, 3 * robot.n, 10 * robot.n + 2, 10 * robot.n + 2])
     assert_same(
         robot.regressor(q, qd, qdd, rotor=True, friction=True, columns=columns),
-        per_sample(lambda *x: robot.regressor(*x, rotor=True, friction=True)[:, columns], q, qd, qdd),
+        per_sample(
+            lambda *x: robot.regressor(*x, rotor=True, friction=True)[:, columns], q, qd, qdd
+        ),
     )
 
 
@@ -88,8 +95,10 @@ def test_lanes_large_joint_angles(lane_path: str, case: str, q_scale: float) -> 
     q, qd, qdd = states(arm, 37, seed=7, q_scale=q_scale)
     q[::3] /= q_scale
     assert_same(robot.rnea(q, qd, qdd), per_sample(robot.rnea, q, qd, qdd))
-    assert_same(robot.regressor(q, qd, qdd, friction=True),
-                per_sample(lambda *x: robot.regressor(*x, friction=True), q, qd, qdd))
+    assert_same(
+        robot.regressor(q, qd, qdd, friction=True),
+        per_sample(lambda *x: robot.regressor(*x, friction=True), q, qd, qdd),
+    )
     assert_same(robot.gravity(q), per_sample(robot.gravity, q))
     assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
 
@@ -100,7 +109,9 @@ def test_lanes_quadrant_boundaries(lane_path: str) -> None:
     arm = make_arm("lwr")
     robot = arm.robot()
     k = np.arange(-40, 41)
-    base = np.concatenate([k * np.pi / 4, np.nextafter(k * np.pi / 4, np.inf), k * np.pi / 2 + 1e-9])
+    base = np.concatenate(
+        [k * np.pi / 4, np.nextafter(k * np.pi / 4, np.inf), k * np.pi / 2 + 1e-9]
+    )
     q = np.resize(base, (base.size // 7 * 7,)).reshape(-1, 7)
     assert_same(robot.gravity(q), per_sample(robot.gravity, q))
     assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
@@ -145,12 +156,16 @@ def test_vectorised_sincos_within_a_few_ulp_of_libm() -> None:
     # next to multiples of pi/4, and an odd count (partial vector).
     rng = np.random.default_rng(11)
     k = np.arange(-2000, 2001)
-    x = np.concatenate([
-        rng.uniform(-np.pi, np.pi, 5001),
-        rng.uniform(-1e5, 1e5, 5001) * rng.choice([1e-8, 1e-3, 1.0], 5001),
-        k * np.pi / 4, np.nextafter(k * np.pi / 4, np.inf), np.nextafter(k * np.pi / 2, -np.inf),
-        [0.0, -0.0, 1e-300, 5e5, 2e6, -3e7, 1e15],
-    ])
+    x = np.concatenate(
+        [
+            rng.uniform(-np.pi, np.pi, 5001),
+            rng.uniform(-1e5, 1e5, 5001) * rng.choice([1e-8, 1e-3, 1.0], 5001),
+            k * np.pi / 4,
+            np.nextafter(k * np.pi / 4, np.inf),
+            np.nextafter(k * np.pi / 2, -np.inf),
+            [0.0, -0.0, 1e-300, 5e5, 2e6, -3e7, 1e15],
+        ]
+    )
     s, c = _core._sincos(x)
     for mine, ref in ((s, np.sin(x)), (c, np.cos(x))):
         ulps = np.abs(mine - ref) / np.spacing(np.abs(ref))

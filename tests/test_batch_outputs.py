@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import make_arm, random_state
 
 import dynid
+from conftest import make_arm, random_state
 from dynid import _core
 
 CALLS = {  # name: (inputs, per-sample shape for n)
@@ -75,28 +75,46 @@ def test_bad_out_is_a_value_error_naming_out(call: str, case: str) -> None:
         getattr(robot, call)(*(inputs[k] for k in names), out=out)
 
 
-@pytest.mark.parametrize("rotor, friction", [(False, False), (True, False), (True, True)])
+@pytest.mark.parametrize(("rotor", "friction"), [(False, False), (True, False), (True, True)])
 @pytest.mark.parametrize("count", [None, 9])
 def test_regressor_columns_select_in_cpp(rotor: bool, friction: bool, count: int | None) -> None:
     robot, s = setup(count)
     full = robot.regressor(s["q"], s["qd"], s["qdd"], rotor=rotor, friction=friction)
     P = full.shape[-1]
     rng = np.random.default_rng(2)
-    for columns in (np.arange(P), rng.permutation(P)[: P // 2], np.array([3, 3, 0]),
-                    dynid.base_parameters(robot, "torque", rotor, friction).independent):
-        Y = robot.regressor(s["q"], s["qd"], s["qdd"], rotor=rotor, friction=friction,
-                            columns=columns)
+    for columns in (
+        np.arange(P),
+        rng.permutation(P)[: P // 2],
+        np.array([3, 3, 0]),
+        dynid.base_parameters(robot, "torque", rotor, friction).independent,
+    ):
+        Y = robot.regressor(
+            s["q"], s["qd"], s["qdd"], rotor=rotor, friction=friction, columns=columns
+        )
         np.testing.assert_array_equal(Y, full[..., columns])
         out = np.empty(Y.shape)
-        robot.regressor(s["q"], s["qd"], s["qdd"], rotor=rotor, friction=friction,
-                        columns=list(columns), out=out)
+        robot.regressor(
+            s["q"],
+            s["qd"],
+            s["qdd"],
+            rotor=rotor,
+            friction=friction,
+            columns=list(columns),
+            out=out,
+        )
         np.testing.assert_array_equal(out, Y)
 
 
 @pytest.mark.parametrize(
-    "columns, message",
-    [([], "non-empty 1-D"), ([[0, 1]], "non-empty 1-D"), ([0.0, 1.0], "integer"),
-     ([0, 50], r"indices in \[0, 50\), got 50"), ([-1], "got -1"), ("a", "non-empty 1-D")],
+    ("columns", "message"),
+    [
+        ([], "non-empty 1-D"),
+        ([[0, 1]], "non-empty 1-D"),
+        ([0.0, 1.0], "integer"),
+        ([0, 50], r"indices in \[0, 50\), got 50"),
+        ([-1], "got -1"),
+        ("a", "non-empty 1-D"),
+    ],
 )
 def test_bad_columns_name_columns(columns, message: str) -> None:
     robot, s = setup(3)

@@ -9,15 +9,24 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import make_arm, random_state
 
+from conftest import make_arm, random_state
 from dynid import _core
 
 CALLS = {
-    "rnea": ("q", "qd", "qdd"), "mass_matrix": ("q",), "gravity": ("q",), "coriolis": ("q", "qd"),
-    "coriolis_matrix": ("q", "qd"), "friction": ("qd",), "forward_dynamics": ("q", "qd", "tau"),
-    "kinetic_energy": ("q", "qd"), "potential_energy": ("q",), "fkine": ("q",),
-    "jacobian": ("q",), "regressor": ("q", "qd", "qdd"), "gravity_regressor": ("q",),
+    "rnea": ("q", "qd", "qdd"),
+    "mass_matrix": ("q",),
+    "gravity": ("q",),
+    "coriolis": ("q", "qd"),
+    "coriolis_matrix": ("q", "qd"),
+    "friction": ("qd",),
+    "forward_dynamics": ("q", "qd", "tau"),
+    "kinetic_energy": ("q", "qd"),
+    "potential_energy": ("q",),
+    "fkine": ("q",),
+    "jacobian": ("q",),
+    "regressor": ("q", "qd", "qdd"),
+    "gravity_regressor": ("q",),
     "inertia_regressor": ("q",),
 }
 ENERGIES = ("kinetic_energy", "potential_energy")
@@ -88,7 +97,7 @@ def test_errors_are_the_full_methods(call: str) -> None:
         params[:, 0] = -1.0
         robot.params = params
         robot.Ia = np.zeros(robot.n)
-        with pytest.raises(ValueError, match="^params: "):
+        with pytest.raises(ValueError, match=r"^params: "):
             robot.forward_dynamics(s["q"], s["qd"], s["tau"])
     if call == "mass_matrix":  # overflow of the result: named ValueError, not inf
         params = np.array(robot.params)

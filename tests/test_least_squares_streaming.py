@@ -95,10 +95,18 @@ def test_streaming_equals_least_squares_whatever_the_chunks(method):
 
 def test_streaming_from_trajectory_chunks_uses_the_cpp_regressor():
     robot, base, (q, qd, qdd, tau) = lwr_problem(2000, seed=2)
-    chunks = ((q[k : k + 300], qd[k : k + 300], qdd[k : k + 300], tau[k : k + 300])
-              for k in range(0, 2000, 300))
+    chunks = (
+        (q[k : k + 300], qd[k : k + 300], qdd[k : k + 300], tau[k : k + 300])
+        for k in range(0, 2000, 300)
+    )
     fit = dynid.least_squares_streaming(
-        robot, chunks, rotor=True, friction=True, columns=base.independent, method="wls", names=base.names
+        robot,
+        chunks,
+        rotor=True,
+        friction=True,
+        columns=base.independent,
+        method="wls",
+        names=base.names,
     )
     Y = robot.regressor(q, qd, qdd, rotor=True, friction=True)[..., base.independent]
     theta, std, _, _ = reference(Y, tau, "wls")

@@ -435,7 +435,7 @@ def test_the_documented_example_runs():
 CORE_SOURCES = ("simulator", "controllers", "rnea", "crba", "gravity", "kinematics", "model",
                 "workspace", "rigid_body", "energy",
                 # the vectorised sin/cos of the joint transforms (2-lane path, no special flags)
-                "batch_dispatch", "batch/lanes_sse2")
+                "batch_dispatch", "batch_lanes_sse2")
 
 
 def find_compiler() -> str | None:

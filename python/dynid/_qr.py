@@ -35,9 +35,7 @@ class GroupedTriangularFactors:
 
     def __init__(self, n: int, p: int, joints: tuple[int, ...]) -> None:
         self.n, self.p, self.joints = n, p, joints
-        self.factors: dict[int, NDArray[np.float64]] = {
-            j: np.zeros((0, p + 1)) for j in joints
-        }
+        self.factors: dict[int, NDArray[np.float64]] = {j: np.zeros((0, p + 1)) for j in joints}
         self.samples = 0
         self.a_exp: int | None = None  # scaled A = A / 2^a_exp
         self.b_exp: int | None = None
@@ -54,8 +52,11 @@ class GroupedTriangularFactors:
             return
         kept = list(self.joints)
         every = len(kept) == self.n
-        largest_a = max(float(np.abs(Y[:, j, :]).max()) for j in kept) if not every else float(
-            np.abs(Y).max())
+        largest_a = (
+            max(float(np.abs(Y[:, j, :]).max()) for j in kept)
+            if not every
+            else float(np.abs(Y).max())
+        )
         largest_b = float(np.abs(tau[:, kept]).max())
         self.max_a, self.max_b = max(self.max_a, largest_a), max(self.max_b, largest_b)
         self._rescale(exponent(np.array([largest_a])), exponent(np.array([largest_b])))

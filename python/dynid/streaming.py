@@ -109,9 +109,7 @@ def least_squares_streaming(
     chunk, so a log of millions of samples can be read and solved piece by piece.
     """
     if not isinstance(robot, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
-            f"robot: expected a dynid.Robot, got {type(robot).__name__}"
-        )
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     index = _columns(columns, robot, rotor, friction)
     accumulator: LeastSquaresAccumulator | None = None
     buffer: NDArray[np.float64] | None = None  # reused while chunks have the same length
@@ -124,13 +122,23 @@ def least_squares_streaming(
                 f"as chunk {k}"
             ) from None
         count = np.shape(q)[0] if np.ndim(q) == 2 else None
-        width = index.size if index is not None else 10 * robot.n + (robot.n if rotor else 0) + (
-            2 * robot.n if friction else 0)
+        width = (
+            index.size
+            if index is not None
+            else 10 * robot.n + (robot.n if rotor else 0) + (2 * robot.n if friction else 0)
+        )
         shape = (count, robot.n, width)
         if count is not None and (buffer is None or buffer.shape != shape):
             buffer = np.empty(shape)
-        Y = robot.regressor(q, qd, qdd, rotor=rotor, friction=friction, columns=index,
-                            out=buffer if count is not None else None)
+        Y = robot.regressor(
+            q,
+            qd,
+            qdd,
+            rotor=rotor,
+            friction=friction,
+            columns=index,
+            out=buffer if count is not None else None,
+        )
         if accumulator is None:
             accumulator = LeastSquaresAccumulator(
                 robot.n, Y.shape[-1], exclude_joints=exclude_joints
@@ -139,7 +147,9 @@ def least_squares_streaming(
     if accumulator is None:
         raise ValueError("chunks: expected at least one (q, qd, qdd, tau) chunk, got none")
     return accumulator.solve(
-        method=method, names=names, on_rank_deficient=on_rank_deficient,
+        method=method,
+        names=names,
+        on_rank_deficient=on_rank_deficient,
         rank_tolerance=rank_tolerance,
     )
 
@@ -152,7 +162,9 @@ def _columns(
     total = 10 * robot.n + (robot.n if rotor else 0) + (2 * robot.n if friction else 0)
     index = np.asarray(columns)
     if index.ndim != 1 or index.size == 0 or index.dtype.kind not in "iu":
-        raise ValueError(f"columns: expected a non-empty 1-D array of column indices, got {columns!r}")
+        raise ValueError(
+            f"columns: expected a non-empty 1-D array of column indices, got {columns!r}"
+        )
     if index.min() < 0 or index.max() >= total:
         raise ValueError(f"columns: expected indices in [0, {total}), got {columns!r}")
     return index.astype(np.int64)

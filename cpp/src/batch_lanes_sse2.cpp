@@ -1,9 +1,10 @@
-// The batch kernels with 2 lanes, compiled with this file's own instruction-set flags
-// (CMakeLists.txt); selected at load time by batch_dispatch.cpp when the CPU supports them.
+// The batch kernels with 2 lanes, compiled with the baseline flags (SSE2 on x86-64; GCC/Clang
+// vector extensions elsewhere), so any build of cpp/src/*.cpp has them; selected at load time
+// by batch_dispatch.cpp (the widest path the CPU supports).
 #define DYNID_LANES 2
 #define DYNID_LANES_NS lanes_sse2_impl
-#include "lane_kernels.hpp"
-#include "lane_regressor.hpp"
+#include "batch/lane_kernels.hpp"
+#include "batch/lane_regressor.hpp"
 
 namespace dynid::detail {
 const LaneKernels lanes_sse2 = {"sse2", 2, &lanes_sse2_impl::rnea, &lanes_sse2_impl::gravity,
