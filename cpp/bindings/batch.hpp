@@ -1,69 +1,133 @@
-// Batches on the SIMD lane kernels (dynid/detail/batch.hpp): the samples split over the batch
-// threads in whole vectors, each thread running the kernel on its contiguous share with the GIL
-// released, the first non-finite result reported like evaluate()'s.
+// The batch loop of the binding: T independent samples evaluated in C++ with the GIL released,
+// in chunks claimed from a shared counter by up to `threads` threads (the calling one included).
+//
+// - Ctrl-C: between chunks the calling thread takes the GIL every kInterruptInterval and runs
+//   Python's signal handlers (PyErr_CheckSignals); when one raises (KeyboardInterrupt), every
+//   thread stops after its current chunk and the exception propagates. A chunk is a few
+//   milliseconds of work, so a batch stops within a few tens of milliseconds.
+// - Threads that cannot be started (the system's thread limit, no memory for a stack or a
+//   workspace) are not an error: the batch runs on the threads that did start, at least the
+//   calling one (dynid.set_threads documents this). No memory for even one workspace raises
+//   MemoryError. An exception in any thread stops the others and is raised after all joined.
 #pragma once
 
+#include <pybind11/pybind11.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <exception>
+#include <new>
+#include <optional>
+#include <system_error>
 #include <thread>
 #include <vector>
 
-#include "dynid/detail/batch.hpp"
-#include "model.hpp"
-
 namespace dynid::binding {
 
-// True when a batch of `s` should use the lane kernels.
-inline bool use_lanes(const PyModel& self, const Samples& s, int max_joints = detail::kMaxBatchJoints) {
-  return !s.single && s.count > 0 && detail::batch_kernels() != nullptr &&
-         self.model->n() <= max_joints;
-}
+namespace py = pybind11;
 
-// kernel(kernels, batch_model, inputs (each at sample `begin`), output at `begin`, count) returns
-// the first non-finite sample relative to `begin`, or -1.
-template <class Kernel>
-py::array evaluate_lanes(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail,
-                         Kernel kernel, py::handle out_arg) {
-  const int n = self.model->n();
-  py::ssize_t per_sample = 1;
-  for (py::ssize_t d : tail) per_sample *= d;
-  tail.insert(tail.begin(), s.count);
-  py::array_t<double> out = output_array(out_arg, tail);
-  double* out_data = out.mutable_data();
-  std::shared_ptr<const Model> model = self.model;
-  std::vector<detail::BatchJoint> joints;
-  const detail::BatchModel bm = detail::batch_model(*model, joints);
-  const detail::LaneKernels& k = *detail::batch_kernels();
-  const py::ssize_t threads = std::max<py::ssize_t>(
-      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
-  std::vector<long> bad(threads, -1);
-  auto run = [&](py::ssize_t part) {
-    // Shares in whole vectors, so only the last one has a partial vector.
-    const py::ssize_t vectors = (s.count + k.lanes - 1) / k.lanes;
-    const py::ssize_t begin = std::min(s.count, vectors * part / threads * k.lanes);
-    const py::ssize_t end = std::min(s.count, vectors * (part + 1) / threads * k.lanes);
-    if (end <= begin) return;
-    const double* in[3] = {nullptr, nullptr, nullptr};
-    for (std::size_t a = 0; a < s.size; ++a) in[a] = s.row(a, begin, n);
-    const long first = kernel(k, bm, in, out_data + begin * per_sample, static_cast<long>(end - begin));
-    if (first >= 0) bad[part] = static_cast<long>(begin) + first;
+// Samples claimed at a time by default: large enough that the shared counter and the clock are
+// read rarely, small enough that a chunk takes a millisecond or less (about 1 us per sample for
+// n = 7). chunk_for_work() scales it down for costlier samples.
+constexpr py::ssize_t kChunk = 256;
+
+// A chunk of about `budget` elementary operations when one sample costs `work_per_sample`.
+inline py::ssize_t chunk_for_work(double work_per_sample, double budget = 65536.0) {
+  const double samples = budget / std::max(work_per_sample, 1.0);
+  return samples >= static_cast<double>(kChunk) ? kChunk
+                                                 : std::max<py::ssize_t>(1, static_cast<py::ssize_t>(samples));
+}
+constexpr std::chrono::milliseconds kInterruptInterval{20};
+
+// True when a Python signal handler raised (its exception is then pending); checks at most
+// every kInterruptInterval. Called with the GIL released, from the thread that released it.
+class InterruptCheck {
+ public:
+  bool raised() {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < kInterruptInterval) return false;
+    last_ = now;
+    py::gil_scoped_acquire gil;
+    return PyErr_CheckSignals() != 0;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// Runs worker(begin, end) over [0, count) in chunks of `chunk` samples; make_worker() builds one worker per thread
+// (in that thread: its workspace). Call with the GIL held; returns the number of threads that
+// took part. Raises the first exception of any thread, or the signal handler's exception.
+template <class MakeWorker>
+int run_batch(py::ssize_t count, int threads, MakeWorker make_worker,
+              py::ssize_t chunk = kChunk) {
+  using Worker = decltype(make_worker());
+  std::atomic<py::ssize_t> next{0};
+  std::atomic<bool> stop{false};
+  int participants = 1;
+  // Claims and runs chunks until none is left or another thread stopped the batch; true when
+  // the caller's interrupt check raised.
+  auto work = [&](Worker& worker, InterruptCheck* interrupt) {
+    while (!stop.load(std::memory_order_relaxed)) {
+      const py::ssize_t begin = next.fetch_add(chunk, std::memory_order_relaxed);
+      if (begin >= count) return false;
+      worker(begin, std::min(begin + chunk, count));
+      if (interrupt && interrupt->raised()) {
+        stop = true;
+        return true;
+      }
+    }
+    return false;
   };
+
+  // Every worker (its workspace) is made here, before any thread starts: a started thread then
+  // allocates nothing and touches no thread-local storage of its own unless a kernel throws, so
+  // it cannot fail for lack of memory (glibc aborts the process when it cannot allocate a
+  // thread's dynamic TLS). Too little memory for all of them means fewer threads; for none, the
+  // std::bad_alloc is raised (MemoryError).
+  std::vector<std::optional<Worker>> workers(static_cast<std::size_t>(std::max(threads, 1)));
+  workers[0].emplace(make_worker());
+  std::size_t ready = 1;
+  try {
+    for (; ready < workers.size(); ++ready) workers[ready].emplace(make_worker());
+  } catch (const std::bad_alloc&) {
+  }
+  std::vector<std::exception_ptr> errors(ready);
+  bool interrupted = false;
   {
     py::gil_scoped_release release;
-    last_batch_threads = static_cast<int>(threads);
-    if (threads == 1) {
-      run(0);
-    } else {
-      std::vector<std::thread> pool;
-      for (py::ssize_t part = 0; part < threads; ++part) pool.emplace_back(run, part);
-      for (std::thread& worker : pool) worker.join();
+    std::vector<std::thread> pool;
+    try {
+      pool.reserve(ready - 1);
+      for (std::size_t k = 1; k < ready; ++k) {
+        pool.emplace_back([&, k] {
+          try {
+            work(*workers[k], nullptr);
+          } catch (...) {
+            errors[k] = std::current_exception();
+            stop = true;
+          }
+        });
+      }
+    } catch (const std::system_error&) {
+      // The system refuses more threads: the batch runs on those started.
+    } catch (const std::bad_alloc&) {
     }
+    participants = static_cast<int>(pool.size()) + 1;
+    try {
+      InterruptCheck interrupt;
+      interrupted = work(*workers[0], &interrupt);
+    } catch (...) {
+      errors[0] = std::current_exception();
+      stop = true;
+    }
+    for (std::thread& thread : pool) thread.join();
   }
-  for (long first : bad)
-    if (first >= 0) require_finite_result(out_data + first * per_sample, per_sample, s.names.c_str());
-  return out;
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
+  if (interrupted) throw py::error_already_set();  // the signal handler's exception
+  return participants;
 }
-
-void bind_batch(py::module_& m);
 
 }  // namespace dynid::binding

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "arrays.hpp"
+#include "batch.hpp"
 #include "dynid/dynid.hpp"
+#include "initialised.hpp"
 
 namespace dynid::binding {
 
@@ -29,6 +31,15 @@ struct PyModel {
     model = std::move(copy);
   }
 };
+
+}  // namespace dynid::binding
+
+// `self` must have been initialised (initialised.hpp).
+template <>
+struct pybind11::detail::type_caster<dynid::binding::PyModel>
+    : dynid::binding::initialised_caster<dynid::binding::PyModel> {};
+
+namespace dynid::binding {
 
 using ConstVec = Eigen::Map<const VectorX>;
 using OutVec = Eigen::Map<VectorX>;
@@ -51,9 +62,10 @@ extern std::atomic<int> last_batch_threads;
 constexpr py::ssize_t kMinSamplesPerThread = 512;
 
 // Runs kernel(model, workspace, inputs, output) on one sample, or on each of T samples in C++
-// with the GIL released, split over batch_threads() threads each with its own Workspace; the
-// output has shape `tail` or (T, *tail) and is `out` when given (output_array). Each sample's
-// output is checked for finiteness right after it is written, while it is in cache.
+// with the GIL released, split over batch_threads() threads each with its own Workspace
+// (run_batch: interruptible by Ctrl-C, fewer threads when the system refuses some); the output
+// has shape `tail` or (T, *tail) and is `out` when given (output_array). Each sample's output is
+// checked for finiteness right after it is written, while it is in cache.
 template <class Kernel>
 py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail, Kernel kernel,
                    py::handle out_arg = py::none()) {
@@ -72,47 +84,30 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
     return out;
   }
   std::shared_ptr<const Model> model = self.model;
-  const py::ssize_t threads = std::max<py::ssize_t>(
-      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
-  std::vector<py::ssize_t> first_bad(threads, -1);
-  auto run = [&](py::ssize_t part) {
-    const py::ssize_t begin = s.count * part / threads, end = s.count * (part + 1) / threads;
-    Workspace ws(*model);
-    const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
-    for (py::ssize_t t = begin; t < end; ++t) {
-      for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
-      double* sample = out_data + t * per_sample;
-      kernel(*model, ws, in, sample);
-      if (!all_finite(sample, per_sample)) {
-        first_bad[part] = t;
-        return;
-      }
-    }
-  };
-  {
-    py::gil_scoped_release release;
-    last_batch_threads = static_cast<int>(threads);
-    if (threads == 1) {
-      run(0);
-    } else {
-      std::vector<std::thread> pool;
-      std::vector<std::exception_ptr> errors(threads);
-      for (py::ssize_t k = 0; k < threads; ++k) {
-        pool.emplace_back([&, k] {
-          try {
-            run(k);
-          } catch (...) {
-            errors[k] = std::current_exception();
+  const int threads = static_cast<int>(std::max<py::ssize_t>(
+      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread)));
+  // One worker per thread, with its own Workspace (batch.hpp: chunks, Ctrl-C, thread failures).
+  std::atomic<py::ssize_t> first_bad{s.count};  // the first sample with a non-finite output
+  auto make_worker = [&] {
+    return [&, ws = Workspace(*model)](py::ssize_t begin, py::ssize_t end) mutable {
+      const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+      for (py::ssize_t t = begin; t < end; ++t) {
+        for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
+        double* sample = out_data + t * per_sample;
+        kernel(*model, ws, in, sample);
+        if (!all_finite(sample, per_sample)) {
+          py::ssize_t seen = first_bad.load();
+          while (t < seen && !first_bad.compare_exchange_weak(seen, t)) {
           }
-        });
+          return;
+        }
       }
-      for (std::thread& worker : pool) worker.join();
-      for (const std::exception_ptr& error : errors)
-        if (error) std::rethrow_exception(error);
-    }
-  }
-  for (py::ssize_t t : first_bad)
-    if (t >= 0) require_finite_result(out_data + t * per_sample, per_sample, s.names.c_str());
+    };
+  };
+  const double work = std::max<double>(static_cast<double>(n) * n, static_cast<double>(per_sample));
+  last_batch_threads = run_batch(s.count, threads, make_worker, chunk_for_work(work));
+  if (first_bad < s.count)
+    require_finite_result(out_data + first_bad * per_sample, per_sample, s.names.c_str());
   return out;
 }
 

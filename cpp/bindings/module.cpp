@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "batch.hpp"
+#include "lanes.hpp"
 #include "fast_calls.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
@@ -17,7 +17,7 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
   dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
-  dynid::binding::bind_batch(m);
+  dynid::binding::bind_lanes(m);
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
   m.def(

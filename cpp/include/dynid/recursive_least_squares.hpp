@@ -65,7 +65,14 @@ class RecursiveLeastSquares {
 
   // One block: Y_k is m x p, tau_k has m entries (any m >= 1). Throws std::invalid_argument on
   // mismatched sizes; the values are not checked here (the Python binding rejects NaN/inf).
+  // Values too large for double precision (|Y|, |tau| around 1e150 and beyond) overflow the
+  // estimate or the covariance factors to inf/NaN: check is_finite() after updates with data
+  // that may be that large, and reset() when it is false (the Python binding checks after every
+  // call and restores the state from before it).
   void update(const MatrixIn& Y_k, const VectorIn& tau_k);
+
+  // True when theta and the covariance factors U, D are all finite (O(p^2) reads, no allocation).
+  bool is_finite() const { return theta_.allFinite() && D_.allFinite() && U_.allFinite(); }
 
   int p() const { return p_; }
   double forgetting() const { return lambda_; }
@@ -84,6 +91,18 @@ class RecursiveLeastSquares {
   // The factors: U unit upper triangular (strict lower part zero), D > 0.
   const MatrixX& covariance_factor_U() const { return U_; }
   const VectorX& covariance_factor_D() const { return D_; }
+
+  // The whole state (current and initial estimate and UD factors, forgetting, variance cap), for
+  // saving an estimator and restoring it exactly (Python pickling).
+  struct State {
+    double forgetting = 1.0, max_variance = 0.0, max_initial_variance = 0.0;
+    VectorX theta, theta0, D, D0;
+    MatrixX U, U0;
+  };
+  State state() const;
+  // An estimator in the given state; std::invalid_argument naming the field when sizes disagree,
+  // forgetting is outside (0, 1] or a value is not finite.
+  static RecursiveLeastSquares from_state(const State& state);
 
  private:
   // Bierman's update with one regressor row y (in h_) and its torque, unit measurement variance.

@@ -1,9 +1,9 @@
 // Python access to the batch path selection (tests run every path the CPU supports).
-#include "batch.hpp"
+#include "lanes.hpp"
 
 namespace dynid::binding {
 
-void bind_batch(py::module_& m) {
+void bind_lanes(py::module_& m) {
   m.def(
       "_batch_isa", [] { return detail::batch_isa(); },
       "The path batch calls of rnea, gravity and mass_matrix run on: 'scalar' (the per-sample "
