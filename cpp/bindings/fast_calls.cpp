@@ -61,7 +61,11 @@ PyObject* fallback(PyObject* method, PyObject* self, PyObject* const* args, Py_s
 PyModel* fast_model(PyObject* self, Py_ssize_t nargsf, PyObject* kwnames, Py_ssize_t count) {
   if (kwnames || PyVectorcall_NARGS(nargsf) != count) return nullptr;
   py::detail::make_caster<PyModel> caster;
-  if (!caster.load(self, false)) return nullptr;
+  try {  // an object made by __new__ without __init__: the full method raises the TypeError
+    if (!caster.load(self, false)) return nullptr;
+  } catch (...) {
+    return nullptr;
+  }
   return &py::detail::cast_op<PyModel&>(caster);
 }
 
