@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "lanes.hpp"
+#include "fast_calls.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 #include "simulator.hpp"
@@ -15,6 +17,7 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
   dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
+  dynid::binding::bind_lanes(m);
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
   m.def(
@@ -45,5 +48,7 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("mass"), py::arg("inertia_com"),
       "Why a body of this mass and inertia about its centre of mass cannot exist ('' if it can).");
-  dynid::binding::add_text_signatures(m);  // last: after every function is defined
+  dynid::binding::add_text_signatures(m);  // after every function is defined
+  // Last: the fast methods take the pybind11 methods' docstrings with their text signatures.
+  dynid::binding::bind_fast_calls(m);
 }
