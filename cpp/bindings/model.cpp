@@ -3,6 +3,7 @@
 #include "model.hpp"
 
 #include "lanes.hpp"
+#include "per_sample.hpp"
 
 #include <atomic>
 #include <cctype>
@@ -66,10 +67,10 @@ VectorX parse_drive(py::handle obj, const char* name, int n) {
   return ConstVec(a.data(), n);
 }
 
-py::object energy(PyModel& self, const Samples& s, py::array result) {
-  if (s.single) return py::float_(*static_cast<const double*>(result.data()));
-  return result;
-}
+// Output shapes per sample (per_sample.hpp has the common ones).
+std::vector<py::ssize_t> pose(int) { return {4, 4}; }
+std::vector<py::ssize_t> twist_by_joint(int n) { return {6, n}; }
+std::vector<py::ssize_t> joint_by_link_parameters(int n) { return {n, 10 * n}; }
 
 }  // namespace
 
@@ -95,7 +96,8 @@ void bind_model(py::module_& m) {
       "_last_batch_threads", [] { return last_batch_threads.load(); },
       "Threads the last batch call ran on.");
 
-  py::class_<PyModel>(m, "Model")
+  py::class_<PyModel> model(m, "Model");
+  model
       .def(py::init([](py::handle dh, const std::string& joint_types, const std::string& convention,
                        py::handle gravity, py::handle base, py::handle tool) {
              std::vector<DHRow> rows = parse_dh(dh, joint_types);
@@ -227,278 +229,157 @@ void bind_model(py::module_& m) {
       .def(
           "_link_inconsistency",
           [](const PyModel& self, int i) { return self.model->link_inconsistency(i); },
-          "Why link i (0-based) is not physically consistent, or '' when it is.")
-      .def(
-          "rnea",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
-            if (use_lanes(self, s))
-              return evaluate_lanes(
-                  self, s, {n},
-                  [](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                     const double* const* in, double* out,
-                     long T) { return k.rnea(bm, in[0], in[1], in[2], out, T); },
-                  out);
-            return evaluate(
-                self, s, {n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutVec tau(out, n);
-                  rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("out") = py::none(),
-          "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).")
-      .def(
-          "mass_matrix",
-          [](PyModel& self, py::handle q, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}}, n);
-            if (use_lanes(self, s))
-              return evaluate_lanes(
-                  self, s, {n, n},
-                  [](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                     const double* const* in, double* out,
-                     long T) { return k.mass_matrix(bm, in[0], out, T); },
-                  out);
-            return evaluate(
-                self, s, {n, n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutMat M = row_major(out, n, n);
-                  crba(m, ws, ConstVec(in[0], n), M);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("out") = py::none(),
-          "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).")
-      .def(
-          "gravity",
-          [](PyModel& self, py::handle q, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}}, n);
-            if (use_lanes(self, s))
-              return evaluate_lanes(
-                  self, s, {n},
-                  [](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                     const double* const* in, double* out,
-                     long T) { return k.gravity(bm, in[0], out, T); },
-                  out);
-            return evaluate(
-                self, s, {n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutVec g(out, n);
-                  gravity(m, ws, ConstVec(in[0], n), g);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("out") = py::none(), "Gravity torques g(q).")
-      .def(
-          "coriolis",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-            return evaluate(
-                self, s, {n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutVec c(out, n);
-                  coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("qd"), py::arg("out") = py::none(),
-          "Coriolis and centrifugal torques c(q, qd).")
-      .def(
-          "coriolis_matrix",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-            return evaluate(
-                self, s, {n, n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutMat S = row_major(out, n, n);
-                  coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("qd"), py::arg("out") = py::none(),
-          "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S "
-          "skew-symmetric.")
-      .def(
-          "friction",
-          [](PyModel& self, py::handle qd, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{qd, "qd"}}, n);
-            return evaluate(
-                self, s, {n},
-                [n](const Model& m, Workspace&, const double* const* in, double* out) {
-                  OutVec tau(out, n);
-                  friction(m, ConstVec(in[0], n), tau);
-                },
-                out);
-          },
-          py::arg("qd"), py::arg("out") = py::none(), "Joint friction Fv qd + Fs sign(qd).")
-      .def(
-          "forward_dynamics",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle tau, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {tau, "tau"}}, n);
-            try {
-              return evaluate(
-                  self, s, {n},
-                  [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                    OutVec qdd(out, n);
-                    forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n),
-                                     ConstVec(in[2], n), qdd);
-                  },
-                  out);
-            } catch (const std::domain_error& e) {
-              throw py::value_error(std::string("params: ") + e.what());
-            }
-          },
-          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("out") = py::none(),
-          "Joint accelerations for the torques tau.")
-      .def(
-          "kinetic_energy",
-          [](PyModel& self, py::handle q, py::handle qd) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-            return energy(
-                self, s,
-                evaluate(self, s, {},
-                         [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                           *out = kinetic_energy(m, ws, ConstVec(in[0], n), ConstVec(in[1], n));
-                         }));
-          },
-          py::arg("q"), py::arg("qd"), "Kinetic energy 1/2 qd^T M(q) qd (rotors included).")
-      .def(
-          "potential_energy",
-          [](PyModel& self, py::handle q) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}}, n);
-            return energy(
-                self, s,
-                evaluate(self, s, {},
-                         [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                           *out = potential_energy(m, ws, ConstVec(in[0], n));
-                         }));
-          },
-          py::arg("q"), "Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).")
-      .def(
-          "fkine",
-          [](PyModel& self, py::handle q, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(
-                self, s, {4, 4},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutMat T = row_major(out, 4, 4);
-                  fkine(m, ws, ConstVec(in[0], n), T);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("out") = py::none(),
-          "World pose (4, 4) of the tool: base A_1 ... A_n tool.")
-      .def(
-          "jacobian",
-          [](PyModel& self, py::handle q, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(
-                self, s, {6, n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  OutMat J = row_major(out, 6, n);
-                  jacobian(m, ws, ConstVec(in[0], n), J);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("out") = py::none(),
-          "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
-      .def(
-          "regressor",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle rotor_flag,
-             py::handle friction_flag, py::handle columns_arg, py::handle out) {
-            const bool rotor = parse_flag(rotor_flag, "rotor");
-            const bool friction = parse_flag(friction_flag, "friction");
-            const int n = self.model->n();
-            const int P = regressor_columns(n, rotor, friction);
-            const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
-            const std::vector<int> columns =
-                columns_arg.is_none() ? std::vector<int>() : parse_columns(columns_arg, P);
-            const int C = columns.empty() ? P : static_cast<int>(columns.size());
-            if (use_lanes(self, s, detail::kMaxRegressorLaneJoints))
-              return evaluate_lanes(
-                  self, s, {n, C},
-                  [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                      const double* const* in, double* out, long T) {
-                    return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
-                                       columns.empty() ? nullptr : columns.data(), C, out, T);
-                  },
-                  out);
-            if (columns_arg.is_none())
-              return evaluate(
-                  self, s, {n, P},
-                  [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                    RowMajorMap Y(out, n, P);
-                    regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n),
-                              rotor, friction, Y);
-                  },
-                  out);
-            // Only the selected columns (e.g. the base parameters'): each sample's full regressor
-            // goes to a per-thread buffer in cache and the columns are copied out of it.
-            return evaluate(
-                self, s, {n, C},
-                [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  thread_local std::vector<double> full;
-                  full.resize(static_cast<std::size_t>(n) * P);
-                  RowMajorMap Y(full.data(), n, P);
-                  regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n),
-                            rotor, friction, Y);
-                  for (int i = 0; i < n; ++i)
-                    for (int k = 0; k < C; ++k)
-                      out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
-                },
-                out);
-          },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false,
-          py::arg("friction") = false, py::arg("columns") = py::none(), py::arg("out") = py::none(),
-          "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; "
-          "with "
-          "columns (indices into the P columns, e.g. base_parameters(...).independent) only those, "
-          "(n, len(columns)); out: a preallocated float64 result array of the exact shape.")
-      .def(
-          "gravity_regressor",
-          [](PyModel& self, py::handle q, py::handle out) {
-            const int n = self.model->n();
-            const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(
-                self, s, {n, 10 * n},
-                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  RowMajorMap Y(out, n, 10 * n);
-                  gravity_regressor(m, ws, ConstVec(in[0], n), Y);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("out") = py::none(),
-          "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
-      .def(
-          "inertia_regressor",
-          [](PyModel& self, py::handle q, py::handle rotor_flag, py::handle out) {
-            const bool rotor = parse_flag(rotor_flag, "rotor");
-            const int n = self.model->n();
-            const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
-            const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(
-                self, s, {rows, P},
-                [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                  RowMajorMap Y(out, rows, P);
-                  inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
-                },
-                out);
-          },
-          py::arg("q"), py::arg("rotor") = false, py::arg("out") = py::none(),
-          "Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] "
-          "(links only, or with the rotor columns the full M) (paper eq. (18)).");
+          "Why link i (0-based) is not physically consistent, or '' when it is.");
+
+  // The per-sample dynamics: inputs, output shape per sample, core call (per_sample.hpp).
+  def_per_sample(
+      model, "rnea", {"q", "qd", "qdd"}, per_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, ConstVec qdd, double* tau) {
+        rnea(m, ws, q, qd, qdd, OutVec(tau, m.n()));
+      },
+      "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).",
+      &detail::LaneKernels::rnea);
+  def_per_sample(
+      model, "mass_matrix", {"q"}, joint_by_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, double* M) {
+        crba(m, ws, q, row_major(M, m.n(), m.n()));
+      },
+      "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).",
+      &detail::LaneKernels::mass_matrix);
+  def_per_sample(
+      model, "gravity", {"q"}, per_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, double* g) {
+        gravity(m, ws, q, OutVec(g, m.n()));
+      },
+      "Gravity torques g(q).", &detail::LaneKernels::gravity);
+  def_per_sample(
+      model, "coriolis", {"q", "qd"}, per_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, double* c) {
+        coriolis(m, ws, q, qd, OutVec(c, m.n()));
+      },
+      "Coriolis and centrifugal torques c(q, qd).");
+  def_per_sample(
+      model, "coriolis_matrix", {"q", "qd"}, joint_by_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, double* S) {
+        coriolis_matrix(m, ws, q, qd, row_major(S, m.n(), m.n()));
+      },
+      "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S "
+      "skew-symmetric.");
+  def_per_sample(
+      model, "friction", {"qd"}, per_joint,
+      [](const Model& m, Workspace&, ConstVec qd, double* tau) {
+        friction(m, qd, OutVec(tau, m.n()));
+      },
+      "Joint friction Fv qd + Fs sign(qd).");
+  // M(q) not positive definite (a std::domain_error) is a ValueError about the parameters.
+  def_per_sample<DomainError::Params>(
+      model, "forward_dynamics", {"q", "qd", "tau"}, per_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, ConstVec tau, double* qdd) {
+        forward_dynamics(m, ws, q, qd, tau, OutVec(qdd, m.n()));
+      },
+      "Joint accelerations for the torques tau.");
+  def_per_sample(
+      model, "kinetic_energy", {"q", "qd"}, scalar,
+      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd) {
+        return kinetic_energy(m, ws, q, qd);
+      },
+      "Kinetic energy 1/2 qd^T M(q) qd (rotors included).");
+  def_per_sample(
+      model, "potential_energy", {"q"}, scalar,
+      [](const Model& m, Workspace& ws, ConstVec q) { return potential_energy(m, ws, q); },
+      "Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).");
+  def_per_sample(
+      model, "fkine", {"q"}, pose,
+      [](const Model& m, Workspace& ws, ConstVec q, double* T) {
+        fkine(m, ws, q, row_major(T, 4, 4));
+      },
+      "World pose (4, 4) of the tool: base A_1 ... A_n tool.");
+  def_per_sample(
+      model, "jacobian", {"q"}, twist_by_joint,
+      [](const Model& m, Workspace& ws, ConstVec q, double* J) {
+        jacobian(m, ws, q, row_major(J, 6, m.n()));
+      },
+      "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].");
+
+  // The regressor keeps its own definition: flags, a column selection and the lane kernel's
+  // joint limit change its shape and kernel.
+  model.def(
+      "regressor",
+      [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle rotor_flag,
+         py::handle friction_flag, py::handle columns_arg, py::handle out) {
+        const bool rotor = parse_flag(rotor_flag, "rotor");
+        const bool friction = parse_flag(friction_flag, "friction");
+        const int n = self.model->n();
+        const int P = regressor_columns(n, rotor, friction);
+        const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
+        const std::vector<int> columns =
+            columns_arg.is_none() ? std::vector<int>() : parse_columns(columns_arg, P);
+        const int C = columns.empty() ? P : static_cast<int>(columns.size());
+        if (use_lanes(self, s, detail::kMaxRegressorLaneJoints))
+          return evaluate_lanes(
+              self, s, {n, C},
+              [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                  const double* const* in, double* out, long T) {
+                return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
+                                   columns.empty() ? nullptr : columns.data(), C, out, T);
+              },
+              out);
+        if (columns_arg.is_none())
+          return evaluate(
+              self, s, {n, P},
+              [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                RowMajorMap Y(out, n, P);
+                regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor,
+                          friction, Y);
+              },
+              out);
+        // Only the selected columns (e.g. the base parameters'): each sample's full regressor
+        // goes to a per-thread buffer in cache and the columns are copied out of it.
+        return evaluate(
+            self, s, {n, C},
+            [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              thread_local std::vector<double> full;
+              full.resize(static_cast<std::size_t>(n) * P);
+              RowMajorMap Y(full.data(), n, P);
+              regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor,
+                        friction, Y);
+              for (int i = 0; i < n; ++i)
+                for (int k = 0; k < C; ++k)
+                  out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
+            },
+            out);
+      },
+      py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false,
+      py::arg("friction") = false, py::arg("columns") = py::none(), py::arg("out") = py::none(),
+      "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; "
+      "with "
+      "columns (indices into the P columns, e.g. base_parameters(...).independent) only those, "
+      "(n, len(columns)); out: a preallocated float64 result array of the exact shape.");
+  def_per_sample(
+      model, "gravity_regressor", {"q"}, joint_by_link_parameters,
+      [](const Model& m, Workspace& ws, ConstVec q, double* Y) {
+        gravity_regressor(m, ws, q, RowMajorMap(Y, m.n(), 10 * m.n()));
+      },
+      "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).");
+  // The inertia regressor's rotor flag changes its shape.
+  model.def(
+      "inertia_regressor",
+      [](PyModel& self, py::handle q, py::handle rotor_flag, py::handle out) {
+        const bool rotor = parse_flag(rotor_flag, "rotor");
+        const int n = self.model->n();
+        const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
+        const Samples s = parse_samples({{q, "q"}}, n);
+        return evaluate(
+            self, s, {rows, P},
+            [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              RowMajorMap Y(out, rows, P);
+              inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
+            },
+            out);
+      },
+      py::arg("q"), py::arg("rotor") = false, py::arg("out") = py::none(),
+      "Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] "
+      "(links only, or with the rotor columns the full M) (paper eq. (18)).");
 }
 
 }  // namespace dynid::binding
