@@ -63,7 +63,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   double* out_data = out.mutable_data();
   const std::size_t arguments = s.size;
   if (s.single) {
-    const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+    const double* in[Samples::kMaxArguments] = {};
     for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
     require_finite_result(out_data, per_sample, s.names.c_str());
@@ -72,7 +72,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   std::shared_ptr<const Model> model = self.model;
   auto run = [&](py::ssize_t begin, py::ssize_t end) {
     Workspace ws(*model);
-    const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+    const double* in[Samples::kMaxArguments] = {};
     for (py::ssize_t t = begin; t < end; ++t) {
       for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
       kernel(*model, ws, in, out_data + t * per_sample);

@@ -27,6 +27,7 @@ Workspace::Workspace(const Model& model)
       M(MatrixX::Zero(n, n)),
       bias(VectorX::Zero(n)),
       cholesky(n),
-      derivatives(n) {}
+      derivatives(n),
+      time_derivatives(n) {}
 
 }  // namespace dynid

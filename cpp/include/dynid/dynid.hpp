@@ -16,5 +16,6 @@
 #include "dynid/regressor.hpp"
 #include "dynid/rnea.hpp"
 #include "dynid/rnea_derivatives.hpp"
+#include "dynid/rnea_time_derivatives.hpp"
 #include "dynid/simulator.hpp"
 #include "dynid/workspace.hpp"

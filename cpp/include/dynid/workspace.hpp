@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "dynid/detail/derivative_buffers.hpp"
+#include "dynid/detail/time_derivative_buffers.hpp"
 #include "dynid/joint_transform.hpp"
 #include "dynid/model.hpp"
 #include "dynid/rigid_body.hpp"
@@ -62,6 +63,9 @@ struct Workspace {
 
   // Analytic derivatives (rnea_derivatives.cpp).
   detail::DerivativeBuffers derivatives;
+
+  // Time derivatives of inverse dynamics (rnea_time_derivatives.cpp).
+  detail::TimeDerivativeBuffers time_derivatives;
 };
 
 }  // namespace dynid
