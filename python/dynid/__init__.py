@@ -36,6 +36,7 @@ from .robot import Robot
 if TYPE_CHECKING:
     from . import models
     from .bounds import DynamicBounds, dynamic_bounds
+    from .elastic import ElasticRobot
     from .cmake import get_cmake_dir, get_include
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
@@ -87,6 +88,8 @@ _LAZY = {
     "VirtualController": ".sim",
     "simulate": ".sim",
     "DynamicBounds": ".bounds",
+    "ElasticRobot": ".elastic",
+    "elastic": ".elastic",
     "dynamic_bounds": ".bounds",
     "PayloadEstimate": ".payload",
     "estimate_payload": ".payload",

@@ -115,9 +115,8 @@ class ElasticRobot:
         """(theta, thetad, thetadd) that make the links follow q(t) with derivatives qd, qdd,
         qddd, qdddd: theta = q + K^-1 tau_l and its two derivatives, tau_l = M qdd + c + g and its
         derivatives exact (``rnea_time_derivatives`` of the rigid body, C++)."""
-        q_, qd_, qdd_, qddd_, qdddd_ = self._samples(q=q, qd=qd, qdd=qdd, qddd=qddd, qdddd=qdddd)
-        tau_l, tau_l_dot, tau_l_ddot = self.link.rnea_time_derivatives(q_, qd_, qdd_, qddd_, qdddd_)
-        return q_ + tau_l / self.K, qd_ + tau_l_dot / self.K, qdd_ + tau_l_ddot / self.K
+        theta, thetad, thetadd, _ = self._flat_output(q, qd, qdd, qddd, qdddd)
+        return theta, thetad, thetadd
 
     def inverse_dynamics(
         self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, qddd: ArrayLike, qdddd: ArrayLike
@@ -125,11 +124,18 @@ class ElasticRobot:
         """(theta, tau): the motor position and motor torque that make the links follow q(t)
         (the link trajectory is a flat output; paper eq. (4)): theta from :meth:`motor_motion`,
         tau = B thetadd + K (theta - q) + tau_F(thetad). One sample (n,) each or (T, n)."""
-        theta, thetad, thetadd = self.motor_motion(q, qd, qdd, qddd, qdddd)
-        q_ = np.asarray(q, dtype=np.float64)
-        tau = (self.B * thetadd + self.K * (theta - q_) + self.Fv_m * thetad
-               + self.Fs_m * np.sign(thetad))
+        theta, thetad, thetadd, tau_l = self._flat_output(q, qd, qdd, qddd, qdddd)
+        # K (theta - q) is tau_l itself: using it avoids the cancellation in theta - q for stiff K
+        tau = self.B * thetadd + tau_l + self.Fv_m * thetad + self.Fs_m * np.sign(thetad)
         return theta, tau
+
+    def _flat_output(
+        self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, qddd: ArrayLike, qdddd: ArrayLike
+    ) -> tuple[Array, Array, Array, Array]:
+        """theta, thetad, thetadd and the link torque tau_l = K (theta - q) for a link motion."""
+        q_, qd_, qdd_, qddd_, qdddd_ = self._samples(q=q, qd=qd, qdd=qdd, qddd=qddd, qdddd=qdddd)
+        tau_l, tau_l_dot, tau_l_ddot = self.link.rnea_time_derivatives(q_, qd_, qdd_, qddd_, qdddd_)
+        return (q_ + tau_l / self.K, qd_ + tau_l_dot / self.K, qdd_ + tau_l_ddot / self.K, tau_l)
 
     # ---- helpers -------------------------------------------------------------------------------
     def _samples(self, **arrays: ArrayLike) -> list[Array]:
