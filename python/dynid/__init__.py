@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from . import models
     from .bounds import DynamicBounds, dynamic_bounds
     from .elastic import ElasticRobot
+    from .elastic_identification import DriveIdentification, identify_drives
     from .cmake import get_cmake_dir, get_include
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
@@ -90,6 +91,8 @@ _LAZY = {
     "DynamicBounds": ".bounds",
     "ElasticRobot": ".elastic",
     "elastic": ".elastic",
+    "DriveIdentification": ".elastic_identification",
+    "identify_drives": ".elastic_identification",
     "dynamic_bounds": ".bounds",
     "PayloadEstimate": ".payload",
     "estimate_payload": ".payload",
