@@ -25,6 +25,8 @@ conventions, prismatic joints; the arms' own Ia, Fv, Fs are set and must be igno
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import re
 import subprocess
@@ -260,6 +262,18 @@ def test_robot_drive_terms_are_not_used_on_the_link_side() -> None:
     for a, b in zip(elastic.inverse_dynamics(q, qd, qdd, qddd, qdddd),
                     other.inverse_dynamics(q, qd, qdd, qddd, qdddd)):
         np.testing.assert_array_equal(a, b)
+
+
+def test_the_documented_example_runs() -> None:
+    """docs/elastic.md's example runs and prints what the page quotes."""
+    text = (REPO / "docs" / "elastic.md").read_text(encoding="utf-8")
+    code = re.findall(r"^```python\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)[-1]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "docs/elastic.md", "exec"), {"__name__": "__docs__"})  # noqa: S102
+    printed = out.getvalue()
+    assert printed.startswith("max deflection 4.2e-03 rad, round trip error "), printed
+    assert float(printed.split()[-1]) < 1e-9, printed
 
 
 # ------------------------------------------------------------------------- real time
