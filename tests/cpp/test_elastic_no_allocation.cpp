@@ -1,5 +1,6 @@
 // Proof that rnea_time_derivatives (the jerk/snap Newton-Euler recursion behind ElasticRobot's
-// inverse dynamics) never touches the heap per call: 10^4 calls on a 7-joint arm (standard DH,
+// inverse dynamics) never touches the heap per call, nor does a run of the ElasticSimulator under
+// the built-in motor PD (500 periods, 5 RK4 substeps): 10^4 calls on a 7-joint arm (standard DH,
 // one prismatic joint, base, tool, drive terms) with every operator new and (on glibc) malloc
 // counted (cpp/examples/allocation_counter.hpp). Also checks that a badly sized argument is a
 // std::invalid_argument whose message starts with the argument's name.
@@ -99,6 +100,27 @@ int main() {
     sink += tau_dot[0] + tau_ddot[n - 1];
   }
   counting = false;
+
+  // A closed-loop run of the elastic-joint simulator under the motor PD (built-in controller):
+  // constructed outside the count, run inside it.
+  dynid::Model links = model;
+  links.set_rotor_inertia(dynid::VectorX::Zero(n));
+  links.set_viscous_friction(dynid::VectorX::Zero(n));
+  links.set_coulomb_friction(dynid::VectorX::Zero(n));
+  const dynid::ElasticDrives drives{dynid::VectorX::Constant(n, 3000.0), dynid::VectorX::Constant(n, 0.4),
+                                    dynid::VectorX::Constant(n, 1.0), dynid::VectorX::Constant(n, 0.2)};
+  dynid::ElasticSimulator simulator(links, drives, 1e-3, 5, 1e-3);
+  dynid::MotorPDController pd(links, drives, dynid::VectorX::Constant(n, 300.0),
+                              dynid::VectorX::Constant(n, 30.0), dynid::VectorX::Constant(n, 0.2));
+  const int periods = 500;
+  dynid::RowMajorMatrixX blocks[6];
+  for (auto& b : blocks) b.resize(periods + 1, n);
+  dynid::ElasticSimulationOutput out{blocks[0], blocks[1], blocks[2], blocks[3], blocks[4], blocks[5]};
+  const dynid::VectorX zero = dynid::VectorX::Zero(n);
+  counting = true;
+  simulator.run(pd, zero, zero, zero, zero, periods, out);
+  counting = false;
+  sink += blocks[0](periods, 0);
   std::printf("allocations_during_calls=%ld\n", allocations);
   std::printf("max_abs_difference_to_rnea=%.3e\n", max_difference_to_rnea);
   if (allocations != 0 || !std::isfinite(sink)) return 1;
@@ -120,5 +142,11 @@ int main() {
   ok &= names_argument("tau", [&] { call(q, qd, qdd, qddd, qdddd, short_out, tau_dot, tau_ddot); });
   ok &= names_argument("tau_dot", [&] { call(q, qd, qdd, qddd, qdddd, tau, short_out, tau_ddot); });
   ok &= names_argument("tau_ddot", [&] { call(q, qd, qdd, qddd, qdddd, tau, tau_dot, short_out); });
+  ok &= names_argument("theta0", [&] { simulator.run(pd, zero, zero, short_v, zero, periods, out); });
+  ok &= names_argument("periods", [&] { simulator.run(pd, zero, zero, zero, zero, 0, out); });
+  dynid::ElasticDrives bad = drives;
+  bad.stiffness[0] = 0.0;
+  ok &= names_argument("stiffness", [&] { dynid::ElasticSimulator(links, bad, 1e-3, 5, 1e-3); });
+  ok &= names_argument("substeps", [&] { dynid::ElasticSimulator(links, drives, 1e-3, 0, 1e-3); });
   return ok ? 0 : 2;
 }
