@@ -122,8 +122,8 @@ def run(
     executable: Path, model_file: Path, *, runs: int, calls: int, states: int, cpu: int | None
 ) -> dict[str, Any]:
     """Run the C++ benchmark; its JSON answer plus the command used."""
-    command = pinning_command(cpu) + [
-        str(executable), str(model_file),
+    command = [
+        *pinning_command(cpu), str(executable), str(model_file),
         "--runs", str(runs), "--calls", str(calls), "--states", str(states),
     ]  # fmt: skip
     done = subprocess.run(command, capture_output=True, text=True, check=False)

@@ -22,10 +22,11 @@ from pathlib import Path
 from typing import Any
 
 import cpp_level  # sibling modules: bench/ is sys.path[0] when run as a script
-import dynid
 import numpy as np
 import pinocchio_arm
 import python_level
+
+import dynid
 
 REPO = Path(__file__).resolve().parent.parent
 

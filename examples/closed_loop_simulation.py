@@ -14,8 +14,9 @@ reversal at t = 7 s the distal joints lose 11-17 mrad (0.1 mrad for a robot with
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
+
+import dynid
 from dynid.sim import ComputedTorque, PDGravity, paper_validation_trajectory, simulate
 
 

@@ -4,7 +4,8 @@ Every object crossing to a worker is pickled: the robot model (``dynid.Robot``),
 identification results all pickle, so each worker runs ``identify_log`` on its own log and sends
 the result back. Dask is an optional extra (``pip install "dynid[dask]"``), not a dependency.
 
-    python examples/dask_identify_logs.py tests/data/measurements_1.npz tests/data/measurements_2.npz
+    python examples/dask_identify_logs.py \\
+        tests/data/measurements_1.npz tests/data/measurements_2.npz
 """
 
 from __future__ import annotations

@@ -111,7 +111,8 @@ def random_arm(
 
 
 def random_state(rng: np.random.Generator, arm_or_types: Arm | str, count: int | None = None):
-    """(q, qd, qdd): revolute q in (-pi, pi), prismatic q in (-0.5, 0.5) m, qd in (-2, 2), qdd in (-3, 3)."""
+    """(q, qd, qdd): revolute q in (-pi, pi), prismatic q in (-0.5, 0.5) m, qd in (-2, 2), qdd in
+    (-3, 3)."""
     types = arm_or_types if isinstance(arm_or_types, str) else arm_or_types.joint_types
     n = len(types)
     shape = (n,) if count is None else (count, n)

@@ -71,7 +71,8 @@ def params_to_physical(p: Array) -> tuple[float, Array, Array]:
 class Arm:
     """A DH arm given by its table and its links in physical form (frame i of `convention`)."""
 
-    dh: Array  # (n, 4): [a, alpha, d, theta_offset] (modified: [a_{i-1}, alpha_{i-1}, d_i, theta_i])
+    # (n, 4): [a, alpha, d, theta_offset] (modified: [a_{i-1}, alpha_{i-1}, d_i, theta_i])
+    dh: Array
     joint_types: str
     convention: str
     mass: Array  # (n,)

@@ -20,9 +20,10 @@ from __future__ import annotations
 import ast
 import dataclasses
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from conftest import SEED, make_arm, random_state
 
 RTOL = 1e-9
@@ -105,7 +106,8 @@ def regressor_of(robot: dynid.Robot, kind: str, rotor: bool, friction: bool, sam
 
 
 def linear_terms(expression: str) -> dict[str, float]:
-    """{name: coefficient} of a sum of ``[c*]name`` terms, parsed with ast (nothing else allowed)."""
+    """{name: coefficient} of a sum of ``[c*]name`` terms, parsed with ast (nothing else
+    allowed)."""
     terms: dict[str, float] = {}
 
     def walk(node: ast.expr, sign: float) -> None:

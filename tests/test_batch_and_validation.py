@@ -15,14 +15,15 @@ import math
 import re
 from collections.abc import Callable
 
-import dynid
 import hypothesis.strategies as st
 import numpy as np
 import pytest
-import reference_model as ref
-from conftest import make_arm, random_inertia_com, random_state
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis.extra.numpy import array_shapes, arrays
+
+import dynid
+import reference_model as ref
+from conftest import make_arm, random_inertia_com, random_state
 
 # name -> (argument names, output shape for one sample given n)
 CALLS: dict[str, tuple[tuple[str, ...], Callable[[int], tuple[int, ...]]]] = {
@@ -356,7 +357,7 @@ def test_impossible_set_link_raises_value_error(case: str) -> None:
     )
 
 
-# ---------------------------------------------------------------- hypothesis: nothing but ValueError
+# ------------------------------------------------------------- hypothesis: nothing but ValueError
 
 FLOAT_DTYPES = (np.float64, np.float32)
 INT_DTYPES = (np.int64, np.int32, np.int8, np.uint8)
@@ -397,7 +398,8 @@ def numeric_arrays(
 def check_outcome(
     fn: Callable[[], object], valid: bool | None, shape: tuple[int, ...] | None
 ) -> None:
-    """valid=True: finite result of `shape`; False: ValueError; None: either (finite result or ValueError)."""
+    """valid=True: finite result of `shape`; False: ValueError; None: either (finite result or
+    ValueError)."""
     try:
         out = fn()
     except ValueError:
@@ -463,8 +465,8 @@ def test_hypothesis_huge_finite_values(call: str, data: st.DataObject) -> None:
     args = [data.draw(arrays(np.float64, shape, elements=huge), label=k) for k in names]
     try:
         out = np.asarray(getattr(r, call)(*args), dtype=float)
-    except ValueError as error:
-        assert any(name in str(error) for name in names), str(error)
+    except ValueError as error:  # either outcome is fine; a ValueError must name an argument
+        assert any(name in str(error) for name in names), str(error)  # noqa: PT017
         return
     assert np.all(np.isfinite(out)), "non-finite result"
     assert out.shape == (out_shape(n) if t is None else (t, *out_shape(n)))

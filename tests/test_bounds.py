@@ -7,10 +7,11 @@ direction angle of qd by a dense grid refined with SciPy: independent of dynid.b
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
 import scipy.optimize
+
+import dynid
 from dynid.bounds import dynamic_bounds
 
 G0 = 9.81

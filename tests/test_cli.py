@@ -1,4 +1,5 @@
-"""`dynid identify`, `dynid validate`, `dynid info`: in process through main(), once as a process."""
+"""`dynid identify`, `dynid validate`, `dynid info`: in process through main(), once as a
+process."""
 
 from __future__ import annotations
 
@@ -6,9 +7,10 @@ import json
 import subprocess
 import sys
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.cli import main
 from dynid.io import save_log
 from dynid.io.model_files import save_model
@@ -90,7 +92,7 @@ ERRORS = [
 ]
 
 
-@pytest.mark.parametrize("argv, message", ERRORS)
+@pytest.mark.parametrize(("argv", "message"), ERRORS)
 def test_errors_exit_2_with_one_line(files, capsys, argv, message):
     assert main([a.format(d=files) for a in argv]) == 2
     err = capsys.readouterr().err

@@ -4,10 +4,11 @@ refused, options are checked."""
 
 from __future__ import annotations
 
-import dynid
-import dynid.cli
 import numpy as np
 import pytest
+
+import dynid
+import dynid.cli
 
 LOG = "tests/data/measurements_1.npz"
 PRIOR = "tests/data/urdf/kuka_lwr4.urdf"

@@ -25,8 +25,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import dynid.cmake
 import pytest
+
+import dynid.cmake
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "cpp" / "examples"
@@ -92,8 +93,8 @@ def test_realtime_example_builds_with_find_package_and_never_allocates(tmp_path,
         # In CI the zero-allocation proof must run, not be skipped.
         assert not os.environ.get("CI"), f"CI needs a C++ compiler and cmake: {compiler}, {cmake}"
         pytest.skip(
-            "needs a C++ compiler (CXX, g++, c++, clang++) and cmake (PATH or `pip install cmake`): "
-            f"compiler={compiler}, cmake={cmake}"
+            "needs a C++ compiler (CXX, g++, c++, clang++) and cmake (PATH or "
+            f"`pip install cmake`): compiler={compiler}, cmake={cmake}"
         )
     build = tmp_path / "build"
     configure = [

@@ -17,9 +17,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from conftest import make_arm, random_arm, random_state
 

@@ -11,9 +11,10 @@ gravity of tests/reference_model.py, the Lagrangian torque, and an RK4 simulatio
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from conftest import ARM_CASES, SEED, lwr_model, make_arm, random_state
 
@@ -116,7 +117,8 @@ def test_gravity_is_gradient_of_potential_energy(robot_and_types, rng) -> None:
 
 
 def test_rnea_equals_sum_of_terms(robot_and_types, rng) -> None:
-    """rnea = M qdd + c + g + Fv qd + Fs sign(qd) (CRBA and RNEA are different algorithms). 1e-10 rel."""
+    """rnea = M qdd + c + g + Fv qd + Fs sign(qd) (CRBA and RNEA are different algorithms).
+    1e-10 rel."""
     robot, types = robot_and_types
     fv, fs = np.asarray(robot.Fv), np.asarray(robot.Fs)
     for _ in range(N_STATES):
@@ -141,7 +143,8 @@ def test_friction_closed_form(robot_and_types, rng) -> None:
 
 
 def test_rnea_matches_lagrangian_torque(arm: ref.Arm, rng) -> None:
-    """Euler-Lagrange on the reference M(q) (finite differences, h = 1e-6) + g + friction. 1e-7 rel."""
+    """Euler-Lagrange on the reference M(q) (finite differences, h = 1e-6) + g + friction.
+    1e-7 rel."""
     robot = arm.robot()
     for _ in range(2):
         q, qd, qdd = random_state(rng, arm)
@@ -212,7 +215,8 @@ def test_forward_dynamics_inverts_rnea(robot_and_types, rng) -> None:
 
 
 def test_forward_dynamics_solves_the_model(arm: ref.Arm, rng) -> None:
-    """qdd = M^-1 (tau - c - g - friction) with M, g from the reference and c from Lagrange. 1e-7 rel."""
+    """qdd = M^-1 (tau - c - g - friction) with M, g from the reference and c from Lagrange.
+    1e-7 rel."""
     robot = arm.robot()
     q, qd, _ = random_state(rng, arm)
     tau = rng.uniform(-5, 5, arm.n)
@@ -297,5 +301,6 @@ def test_kuka_lwr4_model_is_the_paper_table(rng) -> None:
         np.testing.assert_allclose(robot.fkine(q), ref.fkine(arm, q), rtol=0, atol=1e-13)
         assert rel_err(robot.mass_matrix(q), ref.mass_matrix(arm, q)) <= 1e-12
         assert rel_err(robot.gravity(q), ref.gravity(arm, q)) <= 1e-12
-    # zero configuration: the arm stands straight up, flange at 0.4 + 0.39 m on z (frames 0 and 7 as in the paper)
+    # zero configuration: the arm stands straight up, flange at 0.4 + 0.39 m on z (frames 0 and 7
+    # as in the paper)
     np.testing.assert_allclose(robot.fkine(np.zeros(7))[:3, 3], [0.0, 0.0, 0.79], atol=1e-15)

@@ -7,9 +7,10 @@ here with np.linalg.cond on a regressor stacked here.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.excitation import (
     ExcitationResult,
     FourierTrajectory,
@@ -159,7 +160,9 @@ def test_condition_number_matches_an_independent_stacking(lwr, rotor, friction) 
 
 
 def test_gradient_of_the_objective_matches_finite_differences(lwr) -> None:
-    from dynid.excitation.optimization import _LogCondition  # the optimiser's core, checked directly
+    from dynid.excitation.optimization import (
+        _LogCondition,  # the optimiser's core, checked directly
+    )
 
     rng = np.random.default_rng(SEED)
     base = dynid.base_parameters(lwr, "torque", rotor=True, friction=True)
@@ -282,13 +285,13 @@ def test_bad_trajectories_raise_value_error_naming_the_field(kwargs, argument) -
 
 def test_bad_sampling_and_limits_raise_value_error() -> None:
     traj = FourierTrajectory(1.0, np.ones((2, 3)), np.ones((2, 3)), np.zeros(2))
-    with pytest.raises(ValueError, match="^samples, fs:"):
+    with pytest.raises(ValueError, match=r"^samples, fs:"):
         traj.sample()
-    with pytest.raises(ValueError, match="^samples, fs:"):
+    with pytest.raises(ValueError, match=r"^samples, fs:"):
         traj.sample(10, fs=100.0)
-    with pytest.raises(ValueError, match="^fs:"):
+    with pytest.raises(ValueError, match=r"^fs:"):
         traj.sample(fs=-1.0)
-    with pytest.raises(ValueError, match="^qlim:"):
+    with pytest.raises(ValueError, match=r"^qlim:"):
         traj.limits_margin(np.zeros((2, 2)))
-    with pytest.raises(ValueError, match="^trajectory:"):
+    with pytest.raises(ValueError, match=r"^trajectory:"):
         rest_to_rest(FourierTrajectory(1.0, np.ones((2, 1)), np.ones((2, 1)), np.zeros(2)))

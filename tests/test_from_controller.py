@@ -10,9 +10,10 @@ Christoffel terms, and the true base-parameter values beta @ pi.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from dynid.demo import controller_model
 from dynid.sim import VirtualController
@@ -72,7 +73,7 @@ def test_noise_free_gravity_coefficients_are_the_true_base_values(noise_free):
 def test_noise_free_gravity_coefficients_are_the_papers_eq_28(noise_free):
     # Eq. (28) written out by hand over the true standard parameters (m c = first moments).
     truth, ident, _ = noise_free
-    p = {name: value for name, value in zip(truth.parameter_names(), truth.parameter_vector())}
+    p = dict(zip(truth.parameter_names(), truth.parameter_vector()))
     paper = np.array([
         p["my7"],
         p["mx7"],

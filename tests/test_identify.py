@@ -9,9 +9,10 @@ well-conditioned data.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.identify import LeastSquaresResult, RankDeficientError, least_squares, stack_by_joint
 
 
@@ -310,11 +311,11 @@ GOOD_Y, GOOD_TAU = random_problem(13)
 @pytest.mark.parametrize(
     ("kwargs", "argument"),
     [
-        ({"Y": np.where(GOOD_Y == GOOD_Y[0, 0, 0], np.nan, GOOD_Y)}, "Y"),
+        ({"Y": np.where(GOOD_Y[0, 0, 0] == GOOD_Y, np.nan, GOOD_Y)}, "Y"),
         ({"Y": GOOD_Y[:, :, 0]}, "tau"),  # (T, n) Y is one sample of T joints: tau mismatch
         ({"Y": GOOD_Y[0, 0]}, "Y"),
         ({"Y": "abc"}, "Y"),
-        ({"tau": np.where(GOOD_TAU == GOOD_TAU[0, 0], np.inf, GOOD_TAU)}, "tau"),
+        ({"tau": np.where(GOOD_TAU[0, 0] == GOOD_TAU, np.inf, GOOD_TAU)}, "tau"),
         ({"tau": GOOD_TAU[:-1]}, "tau"),
         ({"tau": GOOD_TAU[0]}, "tau"),
         ({"exclude_joints": (3,)}, "exclude_joints"),

@@ -17,11 +17,12 @@ from __future__ import annotations
 import re
 import warnings
 
+import numpy as np
+import pytest
+
 import dynid
 import dynid.cli
 import dynid.demo
-import numpy as np
-import pytest
 from dynid import excitation, signal
 from dynid.from_controller import identify_from_controller, payload_mass_estimates
 from dynid.identify import RankDeficientError, least_squares, stack_by_joint

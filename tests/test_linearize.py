@@ -10,9 +10,10 @@
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from conftest import ARM_CASES, make_arm, random_state
 
 STEP = 1e-6
@@ -121,7 +122,7 @@ def test_batch_and_defaults():
 
 
 @pytest.mark.parametrize(
-    "call, name",
+    ("call", "name"),
     [
         (lambda r: r.linearize(np.zeros(r.n + 1)), "q"),
         (lambda r: r.linearize(np.zeros(r.n), np.zeros(r.n - 1)), "qd"),

@@ -10,9 +10,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.link_frames import express_in_frames_of, link_frames
 from dynid.physical import physical_least_squares
 
@@ -62,12 +63,12 @@ def test_another_arm_is_refused():
     dh = arm_table("standard").dh.copy()
     dh[2, 1] *= -1
     other = dynid.Robot.from_dh(dh, params=arm_table("standard").params)
-    with pytest.raises(ValueError, match="^model:"):
+    with pytest.raises(ValueError, match=r"^model:"):
         express_in_frames_of(other, lwr)
-    with pytest.raises(ValueError, match="^model:"):
+    with pytest.raises(ValueError, match=r"^model:"):
         express_in_frames_of(dynid.models.puma560(), lwr)
     tilted = dynid.Robot.from_dh(lwr.dh, gravity=(0, 9.81, 0), params=lwr.params)
-    with pytest.raises(ValueError, match="^model:"):
+    with pytest.raises(ValueError, match=r"^model:"):
         express_in_frames_of(tilted, lwr)
 
 
@@ -87,7 +88,7 @@ def test_a_prior_in_other_frames_is_mapped_by_the_physical_fit():
                                atol=1e-6 * np.abs(truth.params).max())
     dh = lwr.dh.copy()
     dh[2, 1] *= -1
-    with pytest.raises(ValueError, match="^prior:"):
+    with pytest.raises(ValueError, match=r"^prior:"):
         physical_least_squares(lwr, Y, tau, prior=dynid.Robot.from_dh(dh, params=truth.params),
                                prior_weight=1e-4)
 

@@ -9,10 +9,12 @@ identified model must predict RNEA on another trajectory.
 from __future__ import annotations
 
 import json
+import re
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.identify import RankDeficientError
 from dynid.io import Log
 from dynid.io.result_files import load_result, save_result
@@ -50,7 +52,7 @@ def lwr_result(lwr):
 
 
 @pytest.mark.parametrize("method", ["ols", "wls"])
-@pytest.mark.parametrize("rotor, friction", [(False, False), (True, True)])
+@pytest.mark.parametrize(("rotor", "friction"), [(False, False), (True, True)])
 def test_exact_log_gives_the_true_base_parameters(lwr, method, rotor, friction):
     truth = lwr.copy()
     if not rotor:
@@ -115,7 +117,7 @@ def test_preparation_is_applied_and_recorded(lwr):
     json.dumps(result.training["preparation"])  # plain Python numbers
     notes = " ".join(result.training["notes"])
     assert "computed by second-order central differences" in notes and "decimat" in notes
-    assert result.log is not None and result.log.T == result.training["samples"]
+    assert result.log is not None and result.training["samples"] == result.log.T
 
 
 def test_save_and_load_round_trip(lwr, lwr_result, tmp_path):
@@ -155,13 +157,13 @@ CORRUPT = [
 ]
 
 
-@pytest.mark.parametrize("change, message", CORRUPT)
+@pytest.mark.parametrize(("change", "message"), CORRUPT)
 def test_malformed_result_files_name_the_field(lwr_result, tmp_path, change, message):
     path = save_result(lwr_result, tmp_path, plots=False)
     data = json.loads(path.read_text())
     change(data)
     path.write_text(json.dumps(data))
-    with pytest.raises(ValueError) as info:
+    with pytest.raises(ValueError, match=re.escape(message)) as info:
         load_result(tmp_path)
     assert message in str(info.value) and str(path) in str(info.value)
 
@@ -178,7 +180,7 @@ def test_bad_input(lwr, lwr_result):
     log = fourier_log(lwr, 2, seconds=2.0)
     with pytest.raises(ValueError, match="log: has 7 joints, but the model 'PUMA 560' has 6"):
         identify_log(log, dynid.models.puma560())
-    with pytest.raises(ValueError, match="log: expected a dynid.io.Log"):
+    with pytest.raises(ValueError, match=r"log: expected a dynid.io.Log"):
         identify_log(log.q, lwr)
     with pytest.raises(ValueError, match="method"):
         identify_log(log, lwr, method="lasso")

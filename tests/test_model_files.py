@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import copy
 import json
+import re
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.io.model_files import BUILTIN_MODELS, load_model, model_from_dict, save_model
 
 DATA = Path(__file__).parent / "data"
@@ -123,26 +125,26 @@ MALFORMED = [
 ]
 
 
-@pytest.mark.parametrize("change, message", MALFORMED)
+@pytest.mark.parametrize(("change", "message"), MALFORMED)
 def test_malformed_model_files_name_the_field(change, message, tmp_path):
     model = copy.deepcopy(GOOD)
     model_from_dict(model)  # the unchanged model is fine
     change(model)
     path = tmp_path / "model.json"
     path.write_text(json.dumps(model))
-    with pytest.raises(ValueError) as info:
+    with pytest.raises(ValueError, match=re.escape(message)) as info:
         load_model(path)
     assert str(info.value).startswith(f"{path}: ")
     assert message in str(info.value)
 
 
 def test_file_errors(tmp_path):
-    with pytest.raises(ValueError, match="neither a built-in model .*kuka_lwr4"):
+    with pytest.raises(ValueError, match=r"neither a built-in model .*kuka_lwr4"):
         load_model("kuka")
     with pytest.raises(FileNotFoundError, match="no such file"):
         load_model(tmp_path / "absent.json")
     (tmp_path / "bad.json").write_text('{"convention": "standard",\n "rows": [1, 2,]}')
-    with pytest.raises(ValueError, match="not valid JSON: .* line 2"):
+    with pytest.raises(ValueError, match=r"not valid JSON: .* line 2"):
         load_model(tmp_path / "bad.json")
     (tmp_path / "list.json").write_text("[1, 2]")
     with pytest.raises(ValueError, match="expected an object"):

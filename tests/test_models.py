@@ -14,9 +14,10 @@
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 
 PUMA_QN = np.array([0.0, np.pi / 4, np.pi, 0.0, np.pi / 4, 0.0])
 PUMA_GRAVITY_QN = np.array([0.0, 31.6399, 6.0351, 0.0, 0.0283, 0.0])  # N m, toolbox test_gravload

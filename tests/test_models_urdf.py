@@ -15,10 +15,11 @@ from __future__ import annotations
 import csv
 from importlib.resources import files
 
-import dynid
 import numpy as np
 import pinocchio as pin
 import pytest
+
+import dynid
 from pinocchio_urdf import DATA, assert_matches_pinocchio, relative_error
 from reference_model import params_to_physical
 

@@ -24,9 +24,10 @@ import re
 import subprocess
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from conftest import make_arm
 from test_recursive import find_compiler, find_eigen
 
@@ -141,7 +142,7 @@ def test_the_model_is_copied(contact_run):
 
 
 @pytest.mark.parametrize(
-    "call, name",
+    ("call", "name"),
     [
         (lambda r: dynid.MomentumObserver(r, 0.0, DT), "gain"),
         (lambda r: dynid.MomentumObserver(r, np.ones(r.n - 1), DT), "gain"),
@@ -212,9 +213,9 @@ def test_residual_files_and_plot(tmp_path, contact_run):
     np.testing.assert_array_equal(saved["r"], residual.r)
     png = plot_residual(residual, tmp_path / "residual.png", threshold=1.0)
     assert png.stat().st_size > 10_000
-    with pytest.raises(ValueError, match="^log:"):
+    with pytest.raises(ValueError, match=r"^log:"):
         residual_from_log(robot, "log.npz", 50.0)
-    with pytest.raises(ValueError, match="^model:"):
+    with pytest.raises(ValueError, match=r"^model:"):
         residual_from_log("robot", log, 50.0)
 
 

@@ -1,8 +1,8 @@
 """jacobian_dot, cartesian_inertia and cartesian_dynamics (SPEC §8; Khatib 1987; notes p. 48-49)
 against independent computations:
 
-- jacobian_dot: central finite differences of jacobian(q) along qd, (J(q + h qd) - J(q - h qd)) / 2h,
-  h = 1e-6, 1e-7 relative;
+- jacobian_dot: central finite differences of jacobian(q) along qd,
+  (J(q + h qd) - J(q - h qd)) / 2h, h = 1e-6, 1e-7 relative;
 - for the 6-dof PUMA 560 (square J): the coordinate-transformation formulas of the notes (p. 49)
   Lam = J^-T M J^-1, mu = J^-T c - Lam Jdot qd, p = J^-T g, 1e-9 relative (J^-1 amplifies
   round-off by its condition number, < 1e3 at the sampled configurations);
@@ -12,9 +12,10 @@ against independent computations:
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from conftest import ARM_CASES, make_arm, random_state
 
 
@@ -66,7 +67,7 @@ def test_puma_matches_the_square_jacobian_formulas():
 
 
 @pytest.mark.parametrize(
-    "robot_name, rows",
+    ("robot_name", "rows"),
     [("puma", None), ("lwr", None), ("lwr", "position"), ("lwr", "orientation"),
      ("prismatic_first", "position"), ("prismatic_first", (0, 2, 4)), ("planar", (0, 1))],
 )
@@ -116,10 +117,10 @@ def test_singular_configurations_raise_naming_q():
         puma.cartesian_inertia(q)
     with pytest.raises(ValueError, match=r"^q: singular configuration"):
         puma.cartesian_dynamics(q, np.ones(6))
-    batch = np.array([q + [0, 0, 0, 0, 0.5, 0], q])
+    batch = np.array([q + np.array([0, 0, 0, 0, 0.5, 0]), q])
     with pytest.raises(ValueError, match=r"^q: singular configuration at sample 1"):
         puma.cartesian_inertia(batch)
-    near = [puma.cartesian_inertia(q + [0, 0, 0, 0, eps, 0]) for eps in (1e-3, 2e-3)]
+    near = [puma.cartesian_inertia(q + np.array([0, 0, 0, 0, eps, 0])) for eps in (1e-3, 2e-3)]
     ratio = np.abs(near[0]).max() / np.abs(near[1]).max()
     assert 3.5 < ratio < 4.5  # 1/eps^2
     with pytest.raises(ValueError, match=r"^q: singular configuration"):
@@ -129,7 +130,7 @@ def test_singular_configurations_raise_naming_q():
 
 
 @pytest.mark.parametrize(
-    "call, name",
+    ("call", "name"),
     [
         (lambda r: r.cartesian_inertia(np.zeros(r.n + 1)), "q"),
         (lambda r: r.cartesian_dynamics(np.full(r.n, 0.3), np.zeros(r.n - 1)), "qd"),

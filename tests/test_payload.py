@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import re
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from dynid.demo import TIP_COM, TIP_INERTIA, TIP_MASS, controller_model
 from dynid.sim import VirtualController

@@ -9,9 +9,10 @@ expectations, the delta-method Jacobian (finite differences) and the paper's mas
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.demo import TIP_COM, TIP_INERTIA, TIP_MASS, controller_model
 from dynid.payload import PAYLOAD_NAMES, estimate_payload, physical_from_parameters
 from dynid.sim import VirtualController

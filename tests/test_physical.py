@@ -14,13 +14,14 @@ from __future__ import annotations
 import copy
 import pickle
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.identify import least_squares
 from dynid.io import Log
-from dynid.log_identification import identify_log
 from dynid.io.model_files import save_model
+from dynid.log_identification import identify_log
 from dynid.physical import PhysicalIdentificationError, physical_least_squares
 from dynid.pseudo_inertia import nearest_with_margin, pseudo_inertia, standard_from_pseudo_inertia
 
@@ -211,7 +212,7 @@ def test_data_of_an_impossible_robot_give_a_consistent_robot_and_a_larger_residu
     consistent robot whose residual is at least the LS residual (it is optimal over a smaller
     set), and whose Ia, Fv are on their bounds where the truth is negative (active
     constraints, to 1e-6: an interior-point solution stays ~1e-8 inside)."""
-    bad, Y, tau = inconsistent
+    _bad, Y, tau = inconsistent
     ls = least_squares(Y[..., base.independent], tau)
     ls_sse = np.sum((tau - Y[..., base.independent] @ ls.theta) ** 2)
     fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True)
@@ -283,7 +284,7 @@ def test_infeasible_bounds_raise_with_the_solver_status(lwr, data):
 def test_the_result_robot_is_usable(exact, data, lwr):
     """rnea of result.robot is Y @ theta (1e-9 relative); forward_dynamics inverts rnea (1e-8);
     M(q) is positive definite (Cholesky) at 500 random configurations."""
-    Y, tau = data
+    _Y, _tau = data
     robot = exact.robot
     q, qd, qdd = states(lwr, 500, seed=21)
     tau_robot = robot.rnea(q, qd, qdd)
@@ -315,7 +316,7 @@ def test_terms_not_estimated_are_zero_in_the_result(lwr):
 def test_result_pickles_copies_and_compares(exact):
     again = pickle.loads(pickle.dumps(exact))
     assert again == exact and copy.deepcopy(exact) == exact and copy.copy(exact) == exact
-    assert exact != "something else" and not (exact == 3)
+    assert exact != "something else" and not (exact == 3)  # noqa: SIM201 (tests __eq__, not __ne__)
     np.testing.assert_array_equal(again.robot.params, exact.robot.params)
     q = again.robot.random_configurations(3)
     np.testing.assert_array_equal(again.robot.mass_matrix(q), exact.robot.mass_matrix(q))
@@ -363,7 +364,7 @@ def _call(lwr, data, **changes):
     return physical_least_squares(**kwargs)
 
 
-@pytest.mark.parametrize("changes, name", [
+@pytest.mark.parametrize(("changes", "name"), [
     ({"robot": "kuka"}, "robot"),
     ({"Y": np.zeros((10, 7, 5))}, "Y"),
     ({"Y": np.zeros((10, 5, 91))}, "Y"),
@@ -461,11 +462,11 @@ def test_identify_log_takes_a_prior_model_file(lwr, log, tmp_path):
 
 def test_identify_log_checks_the_physical_options(lwr, log):
     log, _ = log
-    with pytest.raises(ValueError, match="^prior:"):
+    with pytest.raises(ValueError, match=r"^prior:"):
         identify_log(log, lwr, prior=lwr)
-    with pytest.raises(ValueError, match="^physical:"):
+    with pytest.raises(ValueError, match=r"^physical:"):
         identify_log(log, lwr, physical="yes")
-    with pytest.raises(ValueError, match="^prior:"):
+    with pytest.raises(ValueError, match=r"^prior:"):
         identify_log(log, lwr, physical=True, prior=3)
 
 
@@ -474,7 +475,7 @@ def test_identify_log_physical_with_excluded_joints_and_ols(lwr, log):
     own terms (Ia1, Fv1, Fs1, offset) are no longer excited, a RuntimeWarning (the least squares
     would raise); the physical fit still explains joints 2-7 to 1e-6 of their torques and
     ignores joint 1."""
-    log, offsets = log
+    log, _offsets = log
     tau = log.tau.copy()
     tau[:, 0] = 50.0
     garbage = log.replace(tau=tau)

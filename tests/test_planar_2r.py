@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 
 TOL = 1e-12
 L1, L2, LC1, LC2, M1, M2, I1, I2 = 1.0, 0.8, 0.45, 0.35, 3.0, 2.0, 0.25, 0.11
@@ -24,7 +25,8 @@ G0 = 9.81
 def build_from_dh(gravity: tuple[float, float, float] = (0.0, -G0, 0.0)) -> dynid.Robot:
     """The same arm built here from its DH table (independent of dynid.models)."""
     robot = dynid.Robot.from_dh([[L1, 0, 0, 0], [L2, 0, 0, 0]], joint_types="RR", gravity=gravity)
-    # rod-like links: Ixx small, Iyy = Izz = I_i (triangle inequalities hold); only Izz acts in-plane
+    # rod-like links: Ixx small, Iyy = Izz = I_i (triangle inequalities hold); only Izz acts
+    # in-plane
     robot.set_link(0, M1, [LC1 - L1, 0, 0], np.diag([0.01, I1, I1]))
     robot.set_link(1, M2, [LC2 - L2, 0, 0], np.diag([0.01, I2, I2]))
     return robot

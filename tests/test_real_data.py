@@ -15,12 +15,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.io import Log, load_log
-from dynid.log_identification import identify_log, validate_log
 from dynid.io.model_files import load_model
+from dynid.log_identification import identify_log, validate_log
 
 DATA = Path(__file__).parent / "data"
 EXAMPLES = Path(__file__).parent.parent / "examples"

@@ -18,9 +18,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.io import load_log
 from dynid.log_identification import DEFAULT_PRIOR_WEIGHT, identify_log, validate_log
 
@@ -100,7 +101,7 @@ def test_the_prior_file_is_the_urdf_in_the_frames_of_kuka_lwr4(lwr):
 
 
 def test_physical_fit_validates_close_to_the_unconstrained_one(fits):
-    ls, physical, ls_metrics, metrics = fits
+    _ls, physical, ls_metrics, metrics = fits
     np.testing.assert_allclose(ls_metrics["relative_rms"], UNCONSTRAINED, rtol=0.05)
     np.testing.assert_allclose(metrics["relative_rms"], PHYSICAL, rtol=0.05)  # guard
     assert np.all(metrics["relative_rms"] <= RATIO_BOUND * ls_metrics["relative_rms"])

@@ -27,12 +27,13 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-import dynid
 import hypothesis.strategies as st
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from numpy.typing import NDArray
+
+import dynid
 
 RLS = dynid.RecursiveLeastSquares
 REPO = Path(__file__).resolve().parents[1]

@@ -11,9 +11,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 
 DATA = json.loads((Path(__file__).parent / "data" / "kuka_lwr4_dh.json").read_text())
 ATOL = 1e-9

@@ -19,9 +19,10 @@ size is O(1) by construction, the scale is max(1, max |expected|).
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from conftest import SEED, make_arm, random_state
 

@@ -13,10 +13,11 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pinocchio as pin  # the test extra's "pin"
 import pytest
+
+import dynid
 from conftest import ARM_CASES, make_arm, random_state
 
 # bench/pinocchio_arm.py: the Pinocchio model of a dynid DH arm, built without dynid's code
@@ -132,7 +133,7 @@ def test_batch_equals_single_samples(threads: int) -> None:
 
 
 @pytest.mark.parametrize(
-    "args, name",
+    ("args", "name"),
     [
         (lambda n: (np.zeros(n + 1), np.zeros(n), np.zeros(n)), "q"),
         (lambda n: (np.zeros(n), np.zeros(n - 1), np.zeros(n)), "qd"),

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import json
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import dynid.cli
 from dynid import excitation, io, signal
 from dynid.io.output_folder import output_folder, write_text_atomic
@@ -50,17 +51,17 @@ def test_base_parameter_cache_follows_gravity() -> None:
 def test_fourier_trajectory_overflow_is_an_error() -> None:
     huge = excitation.FourierTrajectory(1.0, np.full((2, 3), 1e308), np.full((2, 3), 1e308),
                                         np.zeros(2))
-    with pytest.raises(ValueError, match="^t: .*overflow"):
+    with pytest.raises(ValueError, match=r"^t: .*overflow"):
         huge.evaluate(np.linspace(0.0, 1.0, 5))
     ordinary = excitation.FourierTrajectory(1.0, np.ones((2, 3)), np.ones((2, 3)), np.zeros(2))
-    with pytest.raises(ValueError, match="^t: .*overflow"):
+    with pytest.raises(ValueError, match=r"^t: .*overflow"):
         ordinary.evaluate([1e308])
-    q, qd, qdd = ordinary.evaluate([0.0, 0.5])  # ordinary values still work
+    q, _qd, _qdd = ordinary.evaluate([0.0, 0.5])  # ordinary values still work
     assert np.all(np.isfinite(q)) and q.shape == (2, 2)
 
 
 def test_differentiate_overflow_is_an_error() -> None:
-    with pytest.raises(ValueError, match="^x: the derivative overflows"):
+    with pytest.raises(ValueError, match=r"^x: the derivative overflows"):
         signal.differentiate(np.array([0.0, 1e308, -1e308, 0.0]), fs=1e3)
     x = np.sin(np.linspace(0, 1, 101))
     assert np.all(np.isfinite(signal.differentiate(x, fs=100.0)))
@@ -118,14 +119,14 @@ def test_result_folder_is_not_overwritten_silently(small_result, tmp_path) -> No
     save_result(small_result, out, plots=False)
     before = (out / "result.json").read_text()
     (out / "keep.txt").write_text("user file")
-    with pytest.raises(ValueError, match="^output: .*not empty.*overwrite"):
+    with pytest.raises(ValueError, match=r"^output: .*not empty.*overwrite"):
         save_result(small_result, out, plots=False)
     assert (out / "result.json").read_text() == before
     save_result(small_result, out, plots=False, overwrite=True)
     # replaced as a whole: no file of the previous run is left beside the new one
     assert sorted(p.name for p in out.iterdir()) == ["result.json"]
     assert load_result(out).theta.shape == small_result.theta.shape
-    with pytest.raises(ValueError, match="^output: expected a folder path"):
+    with pytest.raises(ValueError, match=r"^output: expected a folder path"):
         save_result(small_result, "", plots=False)
 
 
@@ -133,7 +134,8 @@ def test_a_failing_write_leaves_the_old_folder_untouched(tmp_path) -> None:
     out = tmp_path / "run"
     with output_folder(out) as staging:
         (staging / "a.json").write_text("{}")
-    with pytest.raises(RuntimeError, match="plot failed"), output_folder(out, True) as staging:
+    # The failure must happen inside the staging block, hence more than one statement.
+    with pytest.raises(RuntimeError, match="plot failed"), output_folder(out, True) as staging:  # noqa: PT012
         (staging / "a.json").write_text('{"half": ')
         raise RuntimeError("plot failed")
     assert json.loads((out / "a.json").read_text()) == {}
@@ -302,12 +304,12 @@ def test_foreign_log_columns_and_time_unit(tmp_path) -> None:
         io.load_log(csv_path, columns=mapping)  # the stamps read as seconds
     with pytest.raises(ValueError, match="columns: nothing matches 'joint_\\*' for q"):
         io.load_log(csv_path, columns={"t": "stamp", "q": "joint_*", "tau": "effort_*"})
-    with pytest.raises(ValueError, match="^time_unit: "):
+    with pytest.raises(ValueError, match=r"^time_unit: "):
         io.load_log(csv_path, columns=mapping, time_unit="hours")
     from dynid.io.columns import parse_columns
 
     assert parse_columns("t=stamp, q=pos_*,tau=effort_*") == mapping
-    with pytest.raises(ValueError, match="^columns: unknown signal 'x'"):
+    with pytest.raises(ValueError, match=r"^columns: unknown signal 'x'"):
         parse_columns("x=pos_*")
 
 
@@ -330,7 +332,7 @@ def test_result_file_carries_covariance_units_and_version(small_result, tmp_path
     assert np.allclose(loaded.covariance, small_result.covariance, rtol=1e-15, atol=0)
     data["version"] = 99
     path.write_text(json.dumps(data))
-    with pytest.raises(ValueError, match="version: expected a format version 1..2"):
+    with pytest.raises(ValueError, match=r"version: expected a format version 1..2"):
         load_result(path)
 
 

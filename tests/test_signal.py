@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dynid import signal as sig
 from scipy import signal as sp
+
+from dynid import signal as sig
 
 FS = 200.0  # Hz, the rate of the KUKA LWR4+ logs
 
@@ -140,10 +141,7 @@ def test_differentiate_is_second_order(grid: str) -> None:
     rng = np.random.default_rng(11)
     errors = []
     for h in (0.02, 0.01, 0.005):
-        if grid == "uniform":
-            t = np.arange(0.0, 3.0, h)
-        else:
-            t = jittered_grid(h, 3.0, rng)
+        t = np.arange(0.0, 3.0, h) if grid == "uniform" else jittered_grid(h, 3.0, rng)
         x = np.sin(2.0 * t) + 0.3 * t**3
         exact = 2.0 * np.cos(2.0 * t) + 0.9 * t**2
         errors.append(np.sqrt(np.mean((sig.differentiate(x, t) - exact) ** 2)))

@@ -11,9 +11,10 @@ finite differences.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 import reference_model as ref
 from dynid.demo import controller_model
 from dynid.signal import differentiate, lowpass

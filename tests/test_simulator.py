@@ -18,9 +18,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.sim import (
     PD,
     ComputedTorque,
@@ -424,7 +425,7 @@ def test_the_documented_example_runs():
     assert codes
     for code in codes:
         namespace: dict = {"__name__": "__docs__"}
-        exec(compile(code, "docs", "exec"), namespace)  # noqa: S102 -- the doc's own code
+        exec(compile(code, "docs", "exec"), namespace)
     assert np.abs(namespace["eq33"](namespace["run"].t)[0] - namespace["run"].q).max() > 0.01
 
 
@@ -432,7 +433,7 @@ def test_the_documented_example_runs():
 
 # The sources the simulator and its controllers need.
 CORE_SOURCES = ("simulator", "controllers", "rnea", "crba", "gravity", "kinematics", "model",
-                "workspace", "rigid_body", "energy")
+                "workspace", "rigid_body", "energy", "argument_checks")
 
 
 def find_compiler() -> str | None:

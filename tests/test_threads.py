@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 
 
 @pytest.fixture

@@ -8,9 +8,10 @@ of the original motion.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.time_scaling import scale_motion, scale_time, scale_torques
 
 TOL = 1e-12  # relative to the largest torque: the scaling is exact, only rounding differs

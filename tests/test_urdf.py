@@ -13,10 +13,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pinocchio as pin
 import pytest
+
+import dynid
 from dynid.urdf.reading import standard_parameters
 from pinocchio_urdf import (
     DATA,

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 
 DATA = Path(__file__).parent / "data" / "urdf"
 INERTIAL = ('<inertial><mass value="1"/>'
@@ -53,13 +54,13 @@ def test_floating_and_planar_joints_are_named(kind: str) -> None:
 def test_mimic_joint_on_the_chain_is_named() -> None:
     text = chain(joint("j1", "l0", "l1"), joint("j2", "l1", "l2", extra='<mimic joint="j1"/>'),
                  joint("j3", "l2", "l3"))
-    with pytest.raises(ValueError, match="joint 'j2'.*mimic"):
+    with pytest.raises(ValueError, match=r"joint 'j2'.*mimic"):
         dynid.Robot.from_urdf(text)
 
 
 def test_missing_inertial_names_the_link() -> None:
     text = chain(*SERIAL).replace(f'<link name="l2">{INERTIAL}</link>', '<link name="l2"/>')
-    with pytest.raises(ValueError, match="link 'l2'.*joint 'j2'.*inertial"):
+    with pytest.raises(ValueError, match=r"link 'l2'.*joint 'j2'.*inertial"):
         dynid.Robot.from_urdf(text)
     # massless frames fixed to a moving link are fine (tool0, ee_link of industrial URDFs)
     text = chain(*SERIAL, '<joint name="f" type="fixed"><parent link="l3"/><child link="t"/></joint>',

@@ -7,10 +7,11 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import dynid
 import numpy as np
 import pinocchio as pin
 import pytest
+
+import dynid
 from conftest import ARM_CASES, make_arm, random_arm
 from pinocchio_urdf import relative_error
 
@@ -113,7 +114,7 @@ def test_path_is_written_atomically_and_never_overwritten(tmp_path: Path) -> Non
     text = robot.to_urdf(name="lwr", path=path)
     assert path.read_text(encoding="utf-8") == text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["lwr.urdf"]  # no temporary left
-    with pytest.raises(ValueError, match="path: .* exists; pass overwrite=True"):
+    with pytest.raises(ValueError, match=r"path: .* exists; pass overwrite=True"):
         robot.to_urdf(name="other", path=path)
     assert path.read_text(encoding="utf-8") == text  # untouched
     robot.to_urdf(name="other", path=str(path), overwrite=True)
@@ -122,8 +123,8 @@ def test_path_is_written_atomically_and_never_overwritten(tmp_path: Path) -> Non
         robot.to_urdf(path=path, overwrite="yes")
     with pytest.raises(ValueError, match="is a folder"):
         robot.to_urdf(path=tmp_path)
+    bad = robot.copy()
+    bad.params = -robot.params
     with pytest.raises(ValueError, match="not physically consistent"):  # checked before writing
-        bad = robot.copy()
-        bad.params = -robot.params
         bad.to_urdf(path=tmp_path / "bad.urdf")
     assert not (tmp_path / "bad.urdf").exists()

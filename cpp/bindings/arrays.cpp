@@ -16,20 +16,53 @@ std::string shape_string(const py::array& a) {
   return s + ")";
 }
 
+namespace {
+
+// NumPy's conversion of obj (PyArray_FromAny, as py::array::ensure, which however discards the
+// error): to float64 C-contiguous when as_double, else to an array of any dtype. A null result
+// leaves NumPy's error pending.
+py::object numpy_array(py::handle obj, bool as_double) {
+  auto& api = py::detail::npy_api::get();
+  PyObject* descr = as_double ? py::dtype::of<double>().release().ptr() : nullptr;
+  const int flags = py::detail::npy_api::NPY_ARRAY_ENSUREARRAY_ |
+                    (as_double ? py::array::c_style | py::array::forcecast : 0);
+  return py::reinterpret_steal<py::object>(api.PyArray_FromAny_(obj.ptr(), descr, 0, 0, flags, nullptr));
+}
+
+// A conversion that failed for lack of memory (a huge list, or the float64 copy of a broadcast
+// view) is a MemoryError naming the argument, never a null array dereferenced later.
+void raise_if_out_of_memory(const char* name) {
+  if (!PyErr_Occurred() || !PyErr_ExceptionMatches(PyExc_MemoryError)) return;
+  const py::error_already_set numpy_error;  // fetches and clears it
+  PyErr_Format(PyExc_MemoryError, "%s: not enough memory to convert it to a float64 array (%s)",
+               name, numpy_error.what());
+  throw py::error_already_set();
+}
+
+}  // namespace
+
 Array as_real_array(py::handle obj, const char* name) {
   // Fast path: already a C-contiguous float64 array (no conversion, no dtype inspection).
   if (py::isinstance<Array>(obj)) return py::reinterpret_borrow<Array>(obj);
-  py::array raw = py::array::ensure(obj);
-  if (!raw) {
+  py::object converted = numpy_array(obj, false);
+  if (!converted) {
+    raise_if_out_of_memory(name);
+    PyErr_Clear();
     throw py::value_error(std::string(name) + ": expected an array of real numbers, got " +
                           std::string(py::str(py::type::of(obj).attr("__name__"))));
   }
+  const py::array raw = py::reinterpret_borrow<py::array>(converted);
   const char kind = raw.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u') {
     throw py::value_error(std::string(name) + ": expected real numbers, got dtype " +
                           std::string(py::str(raw.dtype())));
   }
-  return Array::ensure(raw);
+  converted = numpy_array(raw, true);
+  if (!converted) {
+    raise_if_out_of_memory(name);
+    throw py::error_already_set();  // NumPy's own error (always set when the result is null)
+  }
+  return py::reinterpret_steal<Array>(converted.release());
 }
 
 void require_finite(const Array& a, const char* name) {

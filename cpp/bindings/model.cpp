@@ -86,7 +86,8 @@ void bind_model(py::module_& m) {
       [](py::handle threads) { set_batch_threads(parse_count(threads, "threads")); },
       py::arg("threads"),
         "Use this many threads (each with its own workspace, GIL released) for batch calls of "
-        "at least 512 samples per thread. Default 1.");
+        "at least 512 samples per thread. Default 1. Threads the system refuses (memory, thread "
+        "limit) are skipped: the batch runs on those that start, at least the calling one.");
   m.def("get_threads", &batch_threads, "Threads used by batch calls.");
   m.def(
       "_last_batch_threads", [] { return last_batch_threads.load(); },
@@ -215,15 +216,7 @@ void bind_model(py::module_& m) {
           py::arg("i"), py::arg("mass"), py::arg("com"), py::arg("inertia_com"))
       .def(
           "_link_inconsistency",
-          [](const PyModel& self, int i) {
-            if (i < 0 || i >= self.model->n())
-              throw py::value_error("i: expected a link index in [0, " + std::to_string(self.model->n()) +
-                                    "), got " + std::to_string(i));
-            const RigidBodyParameters b = RigidBodyParameters::from_standard(
-                Eigen::Matrix<double, 1, 10>(self.model->parameters().row(i)).data());
-            if (!(b.m > 0.0)) return physical_inconsistency(b.m, Matrix3::Identity());
-            return physical_inconsistency(b.m, b.inertia_about_com());
-          },
+          [](const PyModel& self, int i) { return self.model->link_inconsistency(i); },
           "Why link i (0-based) is not physically consistent, or '' when it is.")
       .def(
           "rnea",

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "arrays.hpp"
+#include "batch.hpp"
 #include "dynid/dynid.hpp"
+#include "initialised.hpp"
 
 namespace dynid::binding {
 
@@ -29,6 +31,15 @@ struct PyModel {
     model = std::move(copy);
   }
 };
+
+}  // namespace dynid::binding
+
+// `self` must have been initialised (initialised.hpp).
+template <>
+struct pybind11::detail::type_caster<dynid::binding::PyModel>
+    : dynid::binding::initialised_caster<dynid::binding::PyModel> {};
+
+namespace dynid::binding {
 
 using ConstVec = Eigen::Map<const VectorX>;
 using OutVec = Eigen::Map<VectorX>;
@@ -51,8 +62,9 @@ extern std::atomic<int> last_batch_threads;
 constexpr py::ssize_t kMinSamplesPerThread = 512;
 
 // Runs kernel(model, workspace, inputs, output) on one sample, or on each of T samples in C++
-// with the GIL released, split over batch_threads() threads each with its own Workspace; the
-// output has shape `tail` or (T, *tail).
+// with the GIL released, split over batch_threads() threads each with its own Workspace
+// (run_batch: interruptible by Ctrl-C, fewer threads when the system refuses some); the output
+// has shape `tail` or (T, *tail).
 template <class Kernel>
 py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail, Kernel kernel) {
   const int n = self.model->n();
@@ -70,37 +82,20 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
     return out;
   }
   std::shared_ptr<const Model> model = self.model;
-  auto run = [&](py::ssize_t begin, py::ssize_t end) {
-    Workspace ws(*model);
-    const double* in[Samples::kMaxArguments] = {};
-    for (py::ssize_t t = begin; t < end; ++t) {
-      for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
-      kernel(*model, ws, in, out_data + t * per_sample);
-    }
-  };
-  const py::ssize_t threads = std::max<py::ssize_t>(
-      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread));
-  py::gil_scoped_release release;
-  last_batch_threads = static_cast<int>(threads);
-  if (threads == 1) {
-    run(0, s.count);
-    require_finite_result(out_data, s.count * per_sample, s.names.c_str());
-    return out;
-  }
-  std::vector<std::thread> pool;
-  std::vector<std::exception_ptr> errors(threads);
-  for (py::ssize_t k = 0; k < threads; ++k) {
-    pool.emplace_back([&, k] {
-      try {
-        run(s.count * k / threads, s.count * (k + 1) / threads);
-      } catch (...) {
-        errors[k] = std::current_exception();
+  const int threads = static_cast<int>(std::max<py::ssize_t>(
+      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread)));
+  // One worker per thread, with its own Workspace (batch.hpp: chunks, Ctrl-C, thread failures).
+  auto make_worker = [&] {
+    return [&, ws = Workspace(*model)](py::ssize_t begin, py::ssize_t end) mutable {
+      const double* in[Samples::kMaxArguments] = {};
+      for (py::ssize_t t = begin; t < end; ++t) {
+        for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
+        kernel(*model, ws, in, out_data + t * per_sample);
       }
-    });
-  }
-  for (std::thread& worker : pool) worker.join();
-  for (const std::exception_ptr& error : errors)
-    if (error) std::rethrow_exception(error);
+    };
+  };
+  const double work = std::max<double>(static_cast<double>(n) * n, static_cast<double>(per_sample));
+  last_batch_threads = run_batch(s.count, threads, make_worker, chunk_for_work(work));
   require_finite_result(out_data, s.count * per_sample, s.names.c_str());
   return out;
 }

@@ -7,6 +7,7 @@
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 #include "simulator.hpp"
+#include "text_signatures.hpp"
 #include "uses.hpp"
 
 namespace py = pybind11;
@@ -46,4 +47,5 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("mass"), py::arg("inertia_com"),
       "Why a body of this mass and inertia about its centre of mass cannot exist ('' if it can).");
+  dynid::binding::add_text_signatures(m);  // last: after every function is defined
 }

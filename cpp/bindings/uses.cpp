@@ -53,7 +53,8 @@ void bind_uses(py::module_& m) {
         });
         py::object index0 = s.single ? py::object(py::int_(0)) : py::object(py::make_tuple(py::ellipsis(), 0, py::slice(), py::slice()));
         py::object index1 = s.single ? py::object(py::int_(1)) : py::object(py::make_tuple(py::ellipsis(), 1, py::slice(), py::slice()));
-        return py::make_tuple(both[index0], both[index1]);
+        // py::array, not the item accessors: pybind11 puts the C++ type names in the signature.
+        return py::make_tuple(py::array(both[index0]), py::array(both[index1]));
       },
       py::arg("q"), py::arg("qd"), py::arg("qdd"),
       "Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, "

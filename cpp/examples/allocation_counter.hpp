@@ -24,6 +24,31 @@ inline void count() {
 }
 }  // namespace
 
+// Under AddressSanitizer (tests/cpp built with -fsanitize=address) the allocation functions
+// belong to the sanitizer's runtime and must not be replaced; its allocator calls a hook for
+// every allocation instead (malloc, operator new, aligned forms alike), which counts the same.
+#if defined(__SANITIZE_ADDRESS__)
+#define DYNID_COUNT_WITH_SANITIZER_HOOK 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define DYNID_COUNT_WITH_SANITIZER_HOOK 1
+#endif
+#endif
+
+#if defined(DYNID_COUNT_WITH_SANITIZER_HOOK)
+// From <sanitizer/allocator_interface.h>, declared here: not every compiler installs that header.
+extern "C" int __sanitizer_install_malloc_and_free_hooks(
+    void (*malloc_hook)(const volatile void*, std::size_t), void (*free_hook)(const volatile void*));
+
+namespace {
+void count_allocation_hook(const volatile void*, std::size_t) { count(); }
+void ignore_free_hook(const volatile void*) {}
+const int allocation_hook_installed =
+    __sanitizer_install_malloc_and_free_hooks(count_allocation_hook, ignore_free_hook);
+}  // namespace
+
+#else  // replace the allocation functions
+
 #if defined(__GLIBC__)
 extern "C" {
 void* __libc_malloc(std::size_t);
@@ -112,3 +137,5 @@ void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcep
 }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { RAW_FREE(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { RAW_FREE(p); }
+
+#endif  // DYNID_COUNT_WITH_SANITIZER_HOOK

@@ -12,15 +12,20 @@
 // block and a vector are summed per link.
 #include "dynid/coriolis_matrix.hpp"
 
-#include "dynid/kinematics.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
 
-void coriolis_matrix(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-                     MatrixOut S) {
+void coriolis_matrix(const Model& model, Workspace& workspace, const VectorIn& q,
+                     const VectorIn& qd, MatrixOut S) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   const int n = ws.n;
-  update_joint_transforms(model, ws, q);
-  update_world_frames(model, ws);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_SHAPE(S, n, n);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
 
   Vector3 w = Vector3::Zero(), u = Vector3::Zero();  // body velocity [w; u] about the world origin
   for (int i = 1; i <= n; ++i) {

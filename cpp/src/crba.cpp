@@ -8,12 +8,15 @@
 // tensor instead of a general R I R^T.
 #include "dynid/crba.hpp"
 
-#include "dynid/kinematics.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
+namespace detail {
 namespace {
 
-using Composite = Workspace::Composite;
+using Composite = WorkspaceBuffers::Composite;
 
 Composite from_body(const RigidBodyParameters& b) {
   return {b.m, b.h, {b.I(0, 0), b.I(0, 1), b.I(0, 2), b.I(1, 1), b.I(1, 2), b.I(2, 2)}};
@@ -57,7 +60,7 @@ void add_to_parent(const JointTransform& X, const Composite& c, Composite& paren
 
 }  // namespace
 
-void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B) {
+void composite_rigid_body(const Model& model, WorkspaceBuffers& ws, MatrixOut B) {
   const int n = ws.n;
   for (int i = 1; i <= n; ++i) ws.composite[i] = from_body(model.body(i - 1));
   for (int i = n; i >= 2; --i) add_to_parent(ws.X[i], ws.composite[i], ws.composite[i - 1]);
@@ -84,9 +87,14 @@ void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B) {
   }
 }
 
-void crba(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut M) {
-  update_joint_transforms(model, ws, q);
-  composite_rigid_body(model, ws, M);
+}  // namespace detail
+
+void crba(const Model& model, Workspace& workspace, const VectorIn& q, MatrixOut M) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_SHAPE(M, model.n(), model.n());
+  detail::update_joint_transforms(model, ws, q);
+  detail::composite_rigid_body(model, ws, M);
   M.diagonal() += model.rotor_inertia();
 }
 

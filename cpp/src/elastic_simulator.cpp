@@ -6,10 +6,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "dynid/crba.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/newton_euler.hpp"
 #include "dynid/gravity.hpp"
-#include "dynid/kinematics.hpp"
-#include "dynid/rnea.hpp"
 
 namespace dynid {
 namespace {
@@ -67,7 +68,7 @@ void MotorPDController::command(int, double, const VectorIn&, const VectorIn&,
 ElasticSimulator::ElasticSimulator(const Model& links, const ElasticDrives& drives, double dt,
                                    int substeps, double coulomb_band)
     : links_(links), drives_(drives), dt_(dt), coulomb_band_(coulomb_band), substeps_(substeps),
-      ws_(links) {
+      workspace_(links) {
   const int n = links.n();
   check_drive(drives.stiffness, n, true, "stiffness");
   check_drive(drives.motor_inertia, n, true, "motor_inertia");
@@ -86,16 +87,21 @@ ElasticSimulator::ElasticSimulator(const Model& links, const ElasticDrives& driv
 
 void ElasticSimulator::rate(const VectorIn& x, const VectorIn& tau, VectorOut xd) {
   const int n = links_.n();
+  const char* function = "ElasticSimulator::rate";  // the checks build no message per call
+  detail::WorkspaceBuffers& ws = detail::checked_buffers(function, links_, workspace_);
+  detail::check_size(function, "x", x.size(), 4 * n, "(q, theta, qd, thetad)");
+  detail::check_size(function, "tau", tau.size(), n, "one per joint");
+  detail::check_size(function, "xd", xd.size(), 4 * n, "(q, theta, qd, thetad)");
   const auto q = x.segment(0, n), theta = x.segment(n, n);
   const auto qd = x.segment(2 * n, n), thetad = x.segment(3 * n, n);
   xd.segment(0, n) = qd;
   xd.segment(n, n) = thetad;
   // Link equation (paper eq. (1)): M qdd = tau_J - c - g, links only (no Ia, Fv, Fs).
-  update_joint_transforms(links_, ws_, q);
-  newton_euler(links_, ws_, qd, ws_.zeros, -links_.gravity_base(), ws_.bias);
-  composite_rigid_body(links_, ws_, ws_.M);
-  ws_.cholesky.compute(ws_.M);
-  if (ws_.cholesky.info() != Eigen::Success)
+  detail::update_joint_transforms(links_, ws, q);
+  detail::newton_euler(links_, ws, qd, ws.zeros, -links_.gravity_base(), ws.bias);
+  detail::composite_rigid_body(links_, ws, ws.M);
+  ws.cholesky.compute(ws.M);
+  if (ws.cholesky.info() != Eigen::Success)
     throw std::domain_error("simulate: the links' mass matrix is not positive definite at this q");
   auto qdd = xd.segment(2 * n, n);
   auto thetadd = xd.segment(3 * n, n);
@@ -104,12 +110,12 @@ void ElasticSimulator::rate(const VectorIn& x, const VectorIn& tau, VectorOut xd
     const double w = thetad[i];
     const double coulomb = coulomb_band_ > 0.0 ? std::tanh(w / coulomb_band_)
                                                : static_cast<double>((w > 0.0) - (w < 0.0));
-    qdd[i] = tau_J - ws_.bias[i];
+    qdd[i] = tau_J - ws.bias[i];
     // Motor equation (paper eq. (2)): B thetadd = tau - tau_J - tau_F.
     thetadd[i] = (tau[i] - tau_J - drives_.motor_viscous[i] * w - drives_.motor_coulomb[i] * coulomb) /
                  drives_.motor_inertia[i];
   }
-  ws_.cholesky.solveInPlace(qdd);
+  ws.cholesky.solveInPlace(qdd);
 }
 
 void ElasticSimulator::run(ElasticController& controller, const VectorIn& q0, const VectorIn& qd0,

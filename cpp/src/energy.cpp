@@ -1,17 +1,22 @@
 #include "dynid/energy.hpp"
 
-#include "dynid/kinematics.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
 
-double kinetic_energy(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd) {
-  update_joint_transforms(model, ws, q);
+double kinetic_energy(const Model& model, Workspace& workspace, const VectorIn& q,
+                      const VectorIn& qd) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  detail::update_joint_transforms(model, ws, q);
   const Vector3 z = Vector3::UnitZ();
   ws.omega[0].setZero();
   ws.v[0].setZero();
   double T = 0.0;
   for (int i = 1; i <= ws.n; ++i) {
-    const JointTransform& X = ws.X[i];
+    const detail::JointTransform& X = ws.X[i];
     const Vector3& w = ws.omega[i - 1];
     ws.omega[i] = X.rotate_to_child(w);
     ws.v[i] = X.rotate_to_child(ws.v[i - 1] + w.cross(X.p));
@@ -28,9 +33,11 @@ double kinetic_energy(const Model& model, Workspace& ws, const VectorIn& q, cons
   return T;
 }
 
-double potential_energy(const Model& model, Workspace& ws, const VectorIn& q) {
-  update_joint_transforms(model, ws, q);
-  update_world_frames(model, ws);
+double potential_energy(const Model& model, Workspace& workspace, const VectorIn& q) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
   double U = 0.0;
   for (int i = 1; i <= ws.n; ++i) {
     const RigidBodyParameters& b = model.body(i - 1);

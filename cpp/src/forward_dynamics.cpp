@@ -4,15 +4,26 @@
 
 #include <stdexcept>
 
-#include "dynid/crba.hpp"
-#include "dynid/rnea.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/newton_euler.hpp"
 
 namespace dynid {
 
-void forward_dynamics(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-                      const VectorIn& tau, VectorOut qdd) {
-  rnea(model, ws, q, qd, ws.zeros, ws.bias);  // also leaves the joint transforms for q in ws.X
-  composite_rigid_body(model, ws, ws.M);
+void forward_dynamics(const Model& model, Workspace& workspace, const VectorIn& q,
+                      const VectorIn& qd, const VectorIn& tau, VectorOut qdd) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_JOINT_VECTOR(tau, model);
+  DYNID_CHECK_JOINT_VECTOR(qdd, model);
+  // The bias c + g + friction: Newton-Euler with qdd = 0.
+  detail::update_joint_transforms(model, ws, q);
+  detail::newton_euler(model, ws, qd, ws.zeros, -model.gravity_base(), ws.bias);
+  for (int i = 0; i < ws.n; ++i) ws.bias[i] += detail::friction_torque(model, i, qd[i]);
+  detail::composite_rigid_body(model, ws, ws.M);
   ws.M.diagonal() += model.rotor_inertia();
   ws.cholesky.compute(ws.M);
   if (ws.cholesky.info() != Eigen::Success)

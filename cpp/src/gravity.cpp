@@ -3,14 +3,18 @@
 // wrench is (m a, h x a) (notes, "Dynamic parameters of robots 3": U_i linear in m_i and m_i r_ci).
 #include "dynid/gravity.hpp"
 
-#include "dynid/kinematics.hpp"
-#include "dynid/rnea.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/newton_euler.hpp"
 
 namespace dynid {
 
-void gravity(const Model& model, Workspace& ws, const VectorIn& q, VectorOut g) {
+void gravity(const Model& model, Workspace& workspace, const VectorIn& q, VectorOut g) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   const int n = ws.n;
-  update_joint_transforms(model, ws, q);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(g, model);
+  detail::update_joint_transforms(model, ws, q);
   ws.a[0] = -model.gravity_base();
   for (int i = 1; i <= n; ++i) {
     ws.a[i] = ws.X[i].rotate_to_child(ws.a[i - 1]);
@@ -18,7 +22,7 @@ void gravity(const Model& model, Workspace& ws, const VectorIn& q, VectorOut g) 
     ws.f[i] = b.m * ws.a[i];
     ws.mu[i] = b.h.cross(ws.a[i]);
   }
-  accumulate_wrenches(model, ws, g);
+  detail::accumulate_wrenches(model, ws, g);
 }
 
 }  // namespace dynid

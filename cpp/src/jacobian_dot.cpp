@@ -10,21 +10,20 @@
 #include <string>
 
 #include "dynid/detail/spatial.hpp"
-#include "dynid/kinematics.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
 
-void jacobian_dot(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
+void jacobian_dot(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
                   MatrixOut Jdot) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
   const int n = model.n();
-  if (qd.size() != n)
-    throw std::invalid_argument("qd: expected " + std::to_string(n) + " values, got " +
-                                std::to_string(qd.size()));
-  if (Jdot.rows() != 6 || Jdot.cols() != n)
-    throw std::invalid_argument("Jdot: expected a 6 x " + std::to_string(n) + " matrix, got " +
-                                std::to_string(Jdot.rows()) + " x " + std::to_string(Jdot.cols()));
-  update_joint_transforms(model, ws, q);  // checks q and the workspace
-  update_world_frames(model, ws);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_SHAPE(Jdot, 6, n);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
   detail::DerivativeBuffers& d = ws.derivatives;
   // Axes and their derivatives (d.dVdq holds Sdot_i = v_{i-1} x S_i = v_i x S_i here).
   Vector6 v = Vector6::Zero();

@@ -1,18 +1,12 @@
 #include "dynid/kinematics.hpp"
 
-#include <stdexcept>
-#include <string>
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
+namespace detail {
 
-void update_joint_transforms(const Model& model, Workspace& ws, const VectorIn& q) {
-  // Every algorithm starts here: one cheap check catches a workspace made for another model or a
-  // q of the wrong length (the Python binding checks shapes before; C++ callers may not).
-  if (ws.n != model.n() || q.size() != model.n())
-    throw std::invalid_argument("q: expected " + std::to_string(model.n()) +
-                                " joint values and a Workspace of this model, got " +
-                                std::to_string(q.size()) + " values and a workspace for " +
-                                std::to_string(ws.n) + " joints");
+void update_joint_transforms(const Model& model, WorkspaceBuffers& ws, const VectorIn& q) {
   for (int i = 1; i <= ws.n; ++i) {
     const JointGeometry& j = model.joint(i - 1);
     const double qi = q[i - 1];
@@ -23,7 +17,7 @@ void update_joint_transforms(const Model& model, Workspace& ws, const VectorIn& 
   }
 }
 
-void update_world_frames(const Model& model, Workspace& ws) {
+void update_world_frames(const Model& model, WorkspaceBuffers& ws) {
   ws.R_world[0] = model.base().topLeftCorner<3, 3>();
   ws.p_world[0] = model.base().topRightCorner<3, 1>();
   for (int i = 1; i <= ws.n; ++i) {
@@ -41,7 +35,7 @@ void update_world_frames(const Model& model, Workspace& ws) {
 
 namespace {
 
-Matrix4 tool_pose(const Model& model, const Workspace& ws) {
+Matrix4 tool_pose(const Model& model, const WorkspaceBuffers& ws) {
   Matrix4 flange = Matrix4::Identity();
   flange.topLeftCorner<3, 3>() = ws.R_world[ws.n];
   flange.topRightCorner<3, 1>() = ws.p_world[ws.n];
@@ -49,17 +43,24 @@ Matrix4 tool_pose(const Model& model, const Workspace& ws) {
 }
 
 }  // namespace
+}  // namespace detail
 
-void fkine(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut T) {
-  update_joint_transforms(model, ws, q);
-  update_world_frames(model, ws);
-  T = tool_pose(model, ws);
+void fkine(const Model& model, Workspace& workspace, const VectorIn& q, MatrixOut T) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_SHAPE(T, 4, 4);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
+  T = detail::tool_pose(model, ws);
 }
 
-void jacobian(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut J) {
-  update_joint_transforms(model, ws, q);
-  update_world_frames(model, ws);
-  const Vector3 tool_point = tool_pose(model, ws).topRightCorner<3, 1>();
+void jacobian(const Model& model, Workspace& workspace, const VectorIn& q, MatrixOut J) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_SHAPE(J, 6, model.n());
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
+  const Vector3 tool_point = detail::tool_pose(model, ws).topRightCorner<3, 1>();
   for (int i = 1; i <= ws.n; ++i) {
     // Joint i acts along z of J_i (joint_transform.hpp).
     const Vector3 z = ws.R_world[i].col(2);

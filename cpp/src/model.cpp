@@ -54,10 +54,10 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   // constant Tx(a_{i-1}) Rx(alpha_{i-1}) of the previous row precedes joint i, and link i's DH
   // frame sits at J_i * Tx(a_i) Rx(alpha_i).
   joints_.resize(n_);
-  offsets_.assign(n_, LinkOffset{});
+  offsets_.assign(n_, detail::LinkOffset{});
   for (int i = 0; i < n_; ++i) {
     const DHRow& r = rows_[i];
-    JointGeometry& j = joints_[i];
+    detail::JointGeometry& j = joints_[i];
     j.revolute = r.type == JointType::Revolute;
     j.theta = r.theta;
     j.d = r.d;
@@ -73,7 +73,7 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
     j.cos_alpha = std::cos(alpha);
     j.sin_alpha = std::sin(alpha);
     if (convention_ == Convention::Standard) {
-      offsets_[i] = LinkOffset{false, std::cos(r.alpha), std::sin(r.alpha), r.a};
+      offsets_[i] = detail::LinkOffset{false, std::cos(r.alpha), std::sin(r.alpha), r.a};
     }
   }
   update_frames();
@@ -124,6 +124,15 @@ void Model::set_link(int i, const RigidBodyParameters& body) {
   for (int k = 0; k < 10; ++k) parameters_(i, k) = row[k];
   if (!parameters_.row(i).allFinite()) throw std::invalid_argument("params: non-finite value");
   update_bodies();
+}
+
+std::string Model::link_inconsistency(int i) const {
+  if (i < 0 || i >= n_)
+    throw std::invalid_argument("i: expected a link index in [0, " + std::to_string(n_) +
+                                "), got " + std::to_string(i));
+  double row[10];
+  for (int k = 0; k < 10; ++k) row[k] = parameters_(i, k);
+  return physical_inconsistency(RigidBodyParameters::from_standard(row));
 }
 
 void Model::set_rotor_inertia(const VectorIn& Ia) {

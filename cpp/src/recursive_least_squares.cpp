@@ -120,10 +120,13 @@ void RecursiveLeastSquares::set_max_variance(double max_variance) {
 }
 
 void RecursiveLeastSquares::update(const MatrixIn& Y_k, const VectorIn& tau_k) {
-  if (Y_k.cols() != p_ || Y_k.rows() != tau_k.size() || Y_k.rows() < 1)
-    throw std::invalid_argument("Y_k, tau_k: expected an m x " + std::to_string(p_) +
-                                " block and m torques, m >= 1, got " + std::to_string(Y_k.rows()) +
-                                " x " + std::to_string(Y_k.cols()) + " and " +
+  if (Y_k.cols() != p_ || Y_k.rows() < 1)
+    throw std::invalid_argument("Y_k: expected an m x " + std::to_string(p_) +
+                                " block with m >= 1, got " + std::to_string(Y_k.rows()) + " x " +
+                                std::to_string(Y_k.cols()));
+  if (tau_k.size() != Y_k.rows())
+    throw std::invalid_argument("tau_k: expected " + std::to_string(Y_k.rows()) +
+                                " torques (one per row of Y_k), got " +
                                 std::to_string(tau_k.size()));
   // P / lambda, capped against windup (header); then unit measurement variance per row.
   if (lambda_ != 1.0) D_ = (D_ / lambda_).cwiseMin(max_variance());

@@ -14,11 +14,16 @@
 
 #include <algorithm>
 
-#include "dynid/kinematics.hpp"
-#include "dynid/rnea.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/newton_euler.hpp"
 
 namespace dynid {
 namespace {
+
+using detail::JointTransform;
+using detail::LinkOffset;
+using detail::WorkspaceBuffers;
 
 // The coefficients of u^T I v over the six independent entries of a symmetric I.
 inline void add_quadratic_form(const Vector3& u, const Vector3& v, double* out) {
@@ -35,7 +40,7 @@ struct LinkMotion {
   Vector3 w, wd, a;
 };
 
-inline LinkMotion motion_in_link_frame(const Workspace& ws, int j, const LinkOffset& o) {
+inline LinkMotion motion_in_link_frame(const WorkspaceBuffers& ws, int j, const LinkOffset& o) {
   const Vector3& w = ws.omega[j];
   const Vector3& wd = ws.omegad[j];
   const Vector3 p(o.a, 0.0, 0.0);
@@ -120,7 +125,7 @@ inline Vector6 axis_to_link(const LinkOffset& o, const Vector6& U) {
 }
 
 // Moves the axes of joints 1..j-1 from link frame j-1 to link frame j and adds joint j's own.
-inline void advance_axes(const Model& model, Workspace& ws, int j) {
+inline void advance_axes(const Model& model, WorkspaceBuffers& ws, int j) {
   const LinkOffset& o = model.link_offset(j - 1);
   Vector6 own = Vector6::Zero();
   own[model.joint(j - 1).revolute ? 2 : 5] = 1.0;
@@ -134,7 +139,7 @@ inline void advance_axes(const Model& model, Workspace& ws, int j) {
 }
 
 // Fills the 10n rigid-body columns from the current ws.X and ws.omega/omegad/a.
-void rigid_body_columns(const Model& model, Workspace& ws, RowMajorOut Y) {
+void rigid_body_columns(const Model& model, WorkspaceBuffers& ws, RowMajorOut Y) {
   const int n = ws.n;
   for (int i = 1; i <= n; ++i) std::fill(&Y(i - 1, 0), &Y(i - 1, 0) + 10 * (i - 1), 0.0);
   for (int j = 1; j <= n; ++j) {
@@ -152,11 +157,16 @@ int regressor_columns(int n, bool rotor, bool friction) {
   return 10 * n + (rotor ? n : 0) + (friction ? 2 * n : 0);
 }
 
-void regressor(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
+void regressor(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
                const VectorIn& qdd, bool rotor, bool friction, RowMajorOut Y) {
+  WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   const int n = ws.n;
-  update_joint_transforms(model, ws, q);
-  propagate_motion(model, ws, qd, qdd, -model.gravity_base());
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_JOINT_VECTOR(qdd, model);
+  DYNID_CHECK_SHAPE(Y, n, regressor_columns(n, rotor, friction));
+  detail::update_joint_transforms(model, ws, q);
+  detail::propagate_motion(model, ws, qd, qdd, -model.gravity_base());
   rigid_body_columns(model, ws, Y);
   int column = 10 * n;
   if (rotor) {
@@ -173,19 +183,26 @@ void regressor(const Model& model, Workspace& ws, const VectorIn& q, const Vecto
   }
 }
 
-void gravity_regressor(const Model& model, Workspace& ws, const VectorIn& q, RowMajorOut Yg) {
-  update_joint_transforms(model, ws, q);
-  propagate_motion(model, ws, ws.zeros, ws.zeros, -model.gravity_base());
+void gravity_regressor(const Model& model, Workspace& workspace, const VectorIn& q,
+                       RowMajorOut Yg) {
+  WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_SHAPE(Yg, model.n(), 10 * model.n());
+  detail::update_joint_transforms(model, ws, q);
+  detail::propagate_motion(model, ws, ws.zeros, ws.zeros, -model.gravity_base());
   rigid_body_columns(model, ws, Yg);
 }
 
-void inertia_regressor(const Model& model, Workspace& ws, const VectorIn& q, bool rotor,
+void inertia_regressor(const Model& model, Workspace& workspace, const VectorIn& q, bool rotor,
                        RowMajorOut Ym) {
   // Column k of B is the torque for qdd = e_k at rest without gravity: link j >= k then has
   // wd = s_kj and a = l_kj (its joint-k axis), so entry (i, k) of link j's block is
   //   [ l_i . l_k,  l_i x s_k + l_k x s_i,  K(s_i, s_k) ]   (the body regressor with w = 0).
+  WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   const int n = ws.n;
-  update_joint_transforms(model, ws, q);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_SHAPE(Ym, n * (n + 1) / 2, 10 * n + (rotor ? n : 0));
+  detail::update_joint_transforms(model, ws, q);
   Ym.setZero();
   for (int j = 1; j <= n; ++j) {
     advance_axes(model, ws, j);

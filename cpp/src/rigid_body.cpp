@@ -85,4 +85,9 @@ std::string physical_inconsistency(double mass, const Matrix3& inertia_com) {
   return "";
 }
 
+std::string physical_inconsistency(const RigidBodyParameters& body) {
+  if (!(body.m > 0.0)) return physical_inconsistency(body.m, Matrix3::Identity());
+  return physical_inconsistency(body.m, body.inertia_about_com());
+}
+
 }  // namespace dynid

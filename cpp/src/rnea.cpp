@@ -3,11 +3,15 @@
 // of robots 3"). Joint i acts along z of J_i; X[i] maps J_i to J_{i-1}.
 #include "dynid/rnea.hpp"
 
-#include "dynid/friction.hpp"
-#include "dynid/kinematics.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/newton_euler.hpp"
 
 namespace dynid {
-void propagate_motion(const Model& model, Workspace& ws, const VectorIn& qd, const VectorIn& qdd,
+namespace detail {
+
+void propagate_motion(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd, const VectorIn& qdd,
                       const Vector3& base_acceleration) {
   const Vector3 z = Vector3::UnitZ();
   ws.omega[0].setZero();
@@ -33,7 +37,7 @@ void propagate_motion(const Model& model, Workspace& ws, const VectorIn& qd, con
   }
 }
 
-void newton_euler(const Model& model, Workspace& ws, const VectorIn& qd, const VectorIn& qdd,
+void newton_euler(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd, const VectorIn& qdd,
                   const Vector3& base_acceleration, VectorOut tau) {
   propagate_motion(model, ws, qd, qdd, base_acceleration);
   // Wrench needed to move link i alone, about the origin of J_i.
@@ -46,7 +50,7 @@ void newton_euler(const Model& model, Workspace& ws, const VectorIn& qd, const V
   accumulate_wrenches(model, ws, tau);
 }
 
-void accumulate_wrenches(const Model& model, Workspace& ws, VectorOut tau) {
+void accumulate_wrenches(const Model& model, WorkspaceBuffers& ws, VectorOut tau) {
   for (int i = ws.n; i >= 1; --i) {
     tau[i - 1] = model.joint(i - 1).revolute ? ws.mu[i].z() : ws.f[i].z();
     if (i > 1) {
@@ -58,13 +62,19 @@ void accumulate_wrenches(const Model& model, Workspace& ws, VectorOut tau) {
   }
 }
 
-void rnea(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
-          const VectorIn& qdd, VectorOut tau) {
-  update_joint_transforms(model, ws, q);
-  newton_euler(model, ws, qd, qdd, -model.gravity_base(), tau);
-  const VectorX& Ia = model.rotor_inertia();
-  for (int i = 0; i < ws.n; ++i) tau[i] += Ia[i] * qdd[i] + friction_torque(model, i, qd[i]);
-}
+}  // namespace detail
 
+void rnea(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
+          const VectorIn& qdd, VectorOut tau) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_JOINT_VECTOR(qdd, model);
+  DYNID_CHECK_JOINT_VECTOR(tau, model);
+  detail::update_joint_transforms(model, ws, q);
+  detail::newton_euler(model, ws, qd, qdd, -model.gravity_base(), tau);
+  const VectorX& Ia = model.rotor_inertia();
+  for (int i = 0; i < ws.n; ++i) tau[i] += Ia[i] * qdd[i] + detail::friction_torque(model, i, qd[i]);
+}
 
 }  // namespace dynid

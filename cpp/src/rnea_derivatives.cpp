@@ -24,38 +24,28 @@
 #include <string>
 
 #include "dynid/detail/spatial.hpp"
-#include "dynid/kinematics.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
 namespace {
 
-void require_square(const MatrixOut& m, int n, const char* name) {
-  if (m.rows() != n || m.cols() != n)
-    throw std::invalid_argument(std::string(name) + ": expected a " + std::to_string(n) + " x " +
-                                std::to_string(n) + " matrix, got " + std::to_string(m.rows()) +
-                                " x " + std::to_string(m.cols()));
-}
-
-void require_size(const VectorIn& v, int n, const char* name) {
-  if (v.size() != n)
-    throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(n) +
-                                " values, got " + std::to_string(v.size()));
-}
-
 }  // namespace
 
-void rnea_derivatives(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
+void rnea_derivatives(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
                       const VectorIn& qdd, MatrixOut dtau_dq, MatrixOut dtau_dqd) {
   using detail::force_cross;
   using detail::inertia_times;
   using detail::motion_cross;
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
   const int n = model.n();
-  require_size(qd, n, "qd");
-  require_size(qdd, n, "qdd");
-  require_square(dtau_dq, n, "dtau_dq");
-  require_square(dtau_dqd, n, "dtau_dqd");
-  update_joint_transforms(model, ws, q);  // checks q and the workspace
-  update_world_frames(model, ws);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_JOINT_VECTOR(qdd, model);
+  DYNID_CHECK_SHAPE(dtau_dq, n, n);
+  DYNID_CHECK_SHAPE(dtau_dqd, n, n);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
   detail::DerivativeBuffers& d = ws.derivatives;
 
   // Forward pass: axes, velocity/acceleration variations, each link's inertia, force and D.

@@ -23,21 +23,13 @@
 // and their derivatives Ia qddd + Fv qdd, Ia qdddd + Fv qddd (Coulomb: flat away from qd = 0).
 #include "dynid/rnea_time_derivatives.hpp"
 
-#include <stdexcept>
-#include <string>
-
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/spatial.hpp"
-#include "dynid/friction.hpp"
-#include "dynid/kinematics.hpp"
 
 namespace dynid {
 namespace {
-
-void require_size(Eigen::Index size, int n, const char* name) {
-  if (size != n)
-    throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(n) +
-                                " values, got " + std::to_string(size));
-}
 
 // 6x6 spatial inertia [[I, h^], [-h^, m E]] of a body given by (m, h = m c, I about the origin),
 // the matrix of detail::inertia_times.
@@ -58,20 +50,22 @@ Matrix6 inertia_rate(const Vector6& v, const Matrix6& I) {
 
 }  // namespace
 
-void rnea_time_derivatives(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
+void rnea_time_derivatives(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
                            const VectorIn& qdd, const VectorIn& qddd, const VectorIn& qdddd,
                            VectorOut tau, VectorOut tau_dot, VectorOut tau_ddot) {
   using detail::motion_cross;
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   const int n = model.n();
-  require_size(qd.size(), n, "qd");
-  require_size(qdd.size(), n, "qdd");
-  require_size(qddd.size(), n, "qddd");
-  require_size(qdddd.size(), n, "qdddd");
-  require_size(tau.size(), n, "tau");
-  require_size(tau_dot.size(), n, "tau_dot");
-  require_size(tau_ddot.size(), n, "tau_ddot");
-  update_joint_transforms(model, ws, q);  // checks q and the workspace
-  update_world_frames(model, ws);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_JOINT_VECTOR(qd, model);
+  DYNID_CHECK_JOINT_VECTOR(qdd, model);
+  DYNID_CHECK_JOINT_VECTOR(qddd, model);
+  DYNID_CHECK_JOINT_VECTOR(qdddd, model);
+  DYNID_CHECK_JOINT_VECTOR(tau, model);
+  DYNID_CHECK_JOINT_VECTOR(tau_dot, model);
+  DYNID_CHECK_JOINT_VECTOR(tau_ddot, model);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
   detail::TimeDerivativeBuffers& d = ws.time_derivatives;
 
   Vector6 a_g = Vector6::Zero();
@@ -118,7 +112,7 @@ void rnea_time_derivatives(const Model& model, Workspace& ws, const VectorIn& q,
     const Vector6 &S = d.S[i], &S1 = d.S_dot[i], &S2 = d.S_ddot[i];
     const Vector6 &F = d.force[i], &F1 = d.force_dot[i], &F2 = d.force_ddot[i];
     const int k = i - 1;
-    tau[k] = S.dot(F) + Ia[k] * qdd[k] + friction_torque(model, k, qd[k]);
+    tau[k] = S.dot(F) + Ia[k] * qdd[k] + detail::friction_torque(model, k, qd[k]);
     tau_dot[k] = S1.dot(F) + S.dot(F1) + Ia[k] * qddd[k] + Fv[k] * qdd[k];
     tau_ddot[k] = S2.dot(F) + 2.0 * S1.dot(F1) + S.dot(F2) + Ia[k] * qdddd[k] + Fv[k] * qddd[k];
   }

@@ -7,9 +7,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "dynid/crba.hpp"
-#include "dynid/kinematics.hpp"
-#include "dynid/rnea.hpp"
+#include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/newton_euler.hpp"
 
 namespace dynid {
 namespace {
@@ -58,11 +59,15 @@ Simulator::Simulator(const Model& plant, const SimulationSettings& settings)
 void Simulator::acceleration(const VectorIn& q, const VectorIn& qd, const VectorIn& tau,
                              VectorOut qdd) {
   const int n = plant_.n();
-  if (qd.size() != n || tau.size() != n || qdd.size() != n)  // no message built per call
-    throw std::invalid_argument("qd, tau, qdd: expected " + std::to_string(n) + " values each");
-  update_joint_transforms(plant_, ws_, q);  // checks q
+  const char* function = "Simulator::acceleration";  // the checks build no message per call
+  detail::WorkspaceBuffers& ws = detail::checked_buffers(function, plant_, ws_);
+  detail::check_size(function, "q", q.size(), n, "one per joint");
+  detail::check_size(function, "qd", qd.size(), n, "one per joint");
+  detail::check_size(function, "tau", tau.size(), n, "one per joint");
+  detail::check_size(function, "qdd", qdd.size(), n, "one per joint");
+  detail::update_joint_transforms(plant_, ws, q);
   // c(q, qd) + g(q) of the links (Newton-Euler with qdd = 0), then the drive terms.
-  newton_euler(plant_, ws_, qd, ws_.zeros, -plant_.gravity_base(), ws_.bias);
+  detail::newton_euler(plant_, ws, qd, ws.zeros, -plant_.gravity_base(), ws.bias);
   if (settings_.friction) {
     const VectorX& Fv = plant_.viscous_friction();
     const VectorX& Fs = plant_.coulomb_friction();
@@ -70,18 +75,18 @@ void Simulator::acceleration(const VectorIn& q, const VectorIn& qd, const Vector
     for (int i = 0; i < n; ++i) {
       const double coulomb =
           band > 0.0 ? std::tanh(qd[i] / band) : static_cast<double>((qd[i] > 0.0) - (qd[i] < 0.0));
-      ws_.bias[i] += Fv[i] * qd[i] + Fs[i] * coulomb;
+      ws.bias[i] += Fv[i] * qd[i] + Fs[i] * coulomb;
     }
   }
-  composite_rigid_body(plant_, ws_, ws_.M);
-  ws_.M.diagonal() += plant_.rotor_inertia();
-  ws_.cholesky.compute(ws_.M);
-  if (ws_.cholesky.info() != Eigen::Success)
+  detail::composite_rigid_body(plant_, ws, ws.M);
+  ws.M.diagonal() += plant_.rotor_inertia();
+  ws.cholesky.compute(ws.M);
+  if (ws.cholesky.info() != Eigen::Success)
     throw std::domain_error(
         "simulate: the plant's mass matrix is not positive definite at this q (are its "
         "parameters physically consistent?)");
-  qdd = tau - ws_.bias;
-  ws_.cholesky.solveInPlace(qdd);
+  qdd = tau - ws.bias;
+  ws.cholesky.solveInPlace(qdd);
 }
 
 // One classical Runge-Kutta step of x = (q, qd) with the torque held; a1_ already holds

@@ -1,9 +1,9 @@
-#include "dynid/workspace.hpp"
+#include "dynid/detail/workspace_buffers.hpp"
 
-namespace dynid {
+namespace dynid::detail {
 
-Workspace::Workspace(const Model& model)
-    : n(model.n()),
+WorkspaceBuffers::WorkspaceBuffers(int joints)
+    : n(joints),
       X(n + 1),
       omega(n + 1, Vector3::Zero()),
       omegad(n + 1, Vector3::Zero()),
@@ -30,4 +30,4 @@ Workspace::Workspace(const Model& model)
       derivatives(n),
       time_derivatives(n) {}
 
-}  // namespace dynid
+}  // namespace dynid::detail

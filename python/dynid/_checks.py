@@ -91,7 +91,7 @@ def check_finite(array: NDArray[np.float64], name: str) -> None:
 def positive(value: Any, name: str) -> float:
     """A positive finite number (bool refused), as a float."""
     if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name}: expected a positive number, got {value!r}")  # noqa: TRY004 -- SPEC 2
+        raise ValueError(f"{name}: expected a positive number, got {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):

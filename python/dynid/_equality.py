@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import fields
-from typing import Any
+from dataclasses import Field, fields
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -30,10 +30,14 @@ def equal_values(a: Any, b: Any) -> bool:
 class ValueEquality:
     """Mixin for dataclasses (declared with ``eq=False``): ``==`` compares every field by value."""
 
+    if TYPE_CHECKING:  # what @dataclass adds to the classes that use the mixin
+        __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
+
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
         return all(equal_values(getattr(self, f.name), getattr(other, f.name))
-                   for f in fields(self) if f.compare)  # type: ignore[arg-type]
+                   for f in fields(self) if f.compare)
 
-    __hash__ = None  # type: ignore[assignment]  # mutable contents
+    # Unhashable (mutable contents); mypy objects to None in place of the inherited method.
+    __hash__ = None  # type: ignore[assignment]

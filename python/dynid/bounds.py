@@ -108,7 +108,7 @@ def dynamic_bounds(
     for k4, the unit velocity) attaining it. See the module docstring: estimates, not guarantees.
     """
     if not isinstance(robot, Robot):
-        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")  # noqa: TRY004 -- SPEC 2
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     per_start = count(samples_per_start, "samples_per_start", 1)
     samples = count(samples, "samples", per_start,
                     "at least one block of samples_per_start samples")

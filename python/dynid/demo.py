@@ -29,7 +29,7 @@ from ._checks import count
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .robot import Robot
 from .signal import differentiate, lowpass
-from .sim import VirtualController, paper_validation_trajectory
+from .sim import StaticReadings, VirtualController, paper_validation_trajectory
 from .validation import error_metrics, paper_table
 
 #: Fewest training configurations `dynid demo` accepts. The LWR-IV's 12 gravity coefficients are
@@ -200,7 +200,7 @@ def _coefficient_table(ident: IdentifiedModel) -> str:
     return "\n".join(lines)
 
 
-def _inertia_errors(data, ident: IdentifiedModel) -> dict[str, float]:
+def _inertia_errors(data: StaticReadings, ident: IdentifiedModel) -> dict[str, float]:
     error = ident.mass_matrix(data.q) - data.M
     return {"mse": float(np.mean(error**2)), "max_abs": float(np.max(np.abs(error)))}
 

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from ._equality import ValueEquality
 from ._checks import real_array
+from ._equality import ValueEquality
 from .base_parameters import (
     BaseParameters,
     base_parameters,
@@ -198,7 +198,7 @@ def payload_mass_estimates(
             )
     last = base.parameter_names.index(f"m{_link_count(base)}")
     link_columns = slice(last, last + 10)
-    estimates = []
+    estimates: list[dict[str, float | str]] = []
     for k, row in enumerate(base.beta):
         others = np.delete(row[link_columns], 0)
         if row[last] != 0.0 and not np.any(others):
@@ -234,7 +234,7 @@ def _zero_elements(
 ) -> tuple[list[ZeroElement], NDArray[np.float64]]:
     """Elements of M that are zero in all the data although the structure allows them, and an
     orthonormal basis of the coefficients that satisfy the constraints they imply."""
-    scale = np.max(np.abs(M))
+    scale = float(np.max(np.abs(M)))
     constraints = []
     found = []
     for r, (i, k) in enumerate(zip(rows, cols)):

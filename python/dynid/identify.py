@@ -23,8 +23,8 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from ._equality import ValueEquality
 from ._checks import real_array
+from ._equality import ValueEquality
 
 METHODS = ("ols", "wls")
 ON_RANK_DEFICIENT = ("raise", "warn")
@@ -105,7 +105,7 @@ def stack_by_joint(
     keep = [j for j in range(n) if j not in _excluded(exclude_joints, n)]
     A = Y3[:, keep, :].transpose(1, 0, 2).reshape(-1, p)
     b = tau2[:, keep].T.reshape(-1)
-    group = np.repeat(np.array(keep, dtype=np.int64), T)
+    group: NDArray[np.int64] = np.repeat(np.array(keep, dtype=np.int64), T)
     return np.ascontiguousarray(A), np.ascontiguousarray(b), group
 
 
@@ -133,10 +133,11 @@ def least_squares(
     pooled estimate. Each is unbiased when all joints share the same noise level and leverage;
     the exact share (N_j minus the trace of joint j's block of the hat matrix) differs little
     for N >> p, but a much noisier joint leaks into the others' OLS residuals and makes their
-    variances, hence the WLS std, conservative. Variances below ``VARIANCE_FLOOR`` times the largest are raised to it (a joint
-    with exactly zero residual would get an infinite weight); if all are zero, the weights are 1.
-    Rows of joint j are then divided by sigma_j and solved again by the same QR + SVD; the covariance
-    is (A^T W A)^-1 with W = diag(1 / sigma_j^2), taking the estimated variances as known.
+    variances, hence the WLS std, conservative. Variances below ``VARIANCE_FLOOR`` times the
+    largest are raised to it (a joint with exactly zero residual would get an infinite weight); if
+    all are zero, the weights are 1. Rows of joint j are then divided by sigma_j and solved again
+    by the same QR + SVD; the covariance is (A^T W A)^-1 with W = diag(1 / sigma_j^2), taking the
+    estimated variances as known.
 
     ``noise_variance`` holds the sigma_j^2 above (before the floor) for both methods, and
     ``residual_rms`` the per-joint RMS residual of the final fit, in torque units; both follow

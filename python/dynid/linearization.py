@@ -24,9 +24,11 @@ from numpy.typing import ArrayLike, NDArray
 from ._checks import real_array
 
 if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
     from .robot import Robot
 
-Array = NDArray[np.float64]
+Array: TypeAlias = NDArray[np.float64]
 
 
 def linearize(

@@ -60,7 +60,7 @@ def express_in_frames_of(model: Robot, robot: Robot) -> Robot:
                          "convention")
     # Translations: p_i - p'_i = t + R'_i x_i, linear least squares in (t, x_1..x_n).
     n, T = robot.n, q.shape[0]
-    A = np.zeros((T, n, 3, 3 + 3 * n))
+    A: NDArray[np.float64] = np.zeros((T, n, 3, 3 + 3 * n))
     A[..., :3] = np.eye(3)
     for i in range(n):
         A[:, i, :, 3 + 3 * i:6 + 3 * i] = theirs[:, i, :3, :3]

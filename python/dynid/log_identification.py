@@ -21,9 +21,9 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
    that robot (``result.robot``, saved with the result) and its base values as ``theta``.
 
 The result predicts torques on any log (``predict``), is checked on another log
-(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result` (JSON with everything needed
-to apply it again, including the model's DH table, plus PNG plots) and loaded back by
-:func:`dynid.load_result`.
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.io.result_files.save_result`
+(JSON with everything needed to apply it again, including the model's DH table, plus PNG plots)
+and loaded back by :func:`dynid.load_result`.
 """
 
 from __future__ import annotations
@@ -65,7 +65,8 @@ PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "
 
 @dataclass(eq=False)
 class LogIdentification(ValueEquality):
-    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see :func:`identify_log`.
+    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see
+    :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
     (``expressions`` gives each as a combination of the standard ones), then the offsets.
@@ -237,11 +238,11 @@ def identify_log(
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if not isinstance(robot, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"robot: expected a dynid.Robot, got {type(robot).__name__}"
         )
     if not isinstance(physical, (bool, np.bool_)):
@@ -305,6 +306,7 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
               prior: Robot | None, prior_weight: float, source: Any) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one."""
     robot, n = result.robot, result.n
+    assert log.qd is not None and log.qdd is not None  # the prepared log (_with_derivatives)
     Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
     if Y.ndim == 2:
         Y = Y[None]
@@ -425,7 +427,7 @@ def _plain(value: Any) -> Any:
 
 def _with_derivatives(log: Log, n: int, name: str) -> Log:
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if log.n != n:

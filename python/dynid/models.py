@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from importlib.resources import files
+from pathlib import Path
 
 import numpy as np
 
@@ -208,8 +209,8 @@ def puma560() -> Robot:
     ``Ia = Jm G^2``, ``Fv = B G^2`` and ``Fs = |G| (|Tc+| + |Tc-|) / 2``. The toolbox stores
     an asymmetric Coulomb friction ``Tc = [Tc+, Tc-]``, applied for positive and negative
     velocity respectively (its inline comment says "[-,+]", but the values and the toolbox's
-    own test torques fit [+, -]); dynid's Coulomb model ``Fs sign(qd)`` is symmetric, so the mean of the two
-    magnitudes is used. Zero ``Ia``, ``Fv``, ``Fs`` for the rigid-body arm alone.
+    own test torques fit [+, -]); dynid's Coulomb model ``Fs sign(qd)`` is symmetric, so the mean
+    of the two magnitudes is used. Zero ``Ia``, ``Fv``, ``Fs`` for the rigid-body arm alone.
 
     The published parameters are kept as they are, which makes
     ``robot.is_physically_consistent()`` False: link 1 has m = 0 (no mass was reported; it
@@ -338,5 +339,6 @@ def _ur(file: str, name: str, convention: str) -> Robot:
     return robot
 
 
-def _data_file(name: str):
-    return files("dynid").joinpath("data", name)
+def _data_file(name: str) -> Path:
+    # A path (the package is installed as files): np.loadtxt and read_text take it directly.
+    return Path(str(files("dynid") / "data" / name))

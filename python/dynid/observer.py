@@ -24,9 +24,11 @@ from .io.preparation import prepare_log
 from .log_identification import LogIdentification
 
 if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
     from .robot import Robot
 
-Array = NDArray[np.float64]
+Array: TypeAlias = NDArray[np.float64]
 
 
 @dataclass
@@ -52,8 +54,9 @@ def robot_from_identification(result: LogIdentification) -> tuple[Robot, Array]:
     identified are zero). Its parameters are not physically meaningful one by one.
     """
     if not isinstance(result, LogIdentification):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
-            f"model: expected a dynid.Robot or a dynid.LogIdentification, got {type(result).__name__}"
+        raise ValueError(
+            "model: expected a dynid.Robot or a dynid.LogIdentification, got "
+            f"{type(result).__name__}"
         )
     robot = result.robot.copy()
     n = robot.n
@@ -80,7 +83,7 @@ def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | 
     else:
         robot, offsets = robot_from_identification(model)
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")  # noqa: TRY004
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
     if log.n != robot.n:
         raise ValueError(f"log: has {log.n} joints, the model {robot.n}")
     log.check_uniform("the momentum observer")
@@ -88,6 +91,7 @@ def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | 
         log = prepare_log(log, differentiate="missing")
     dt = float(np.median(np.diff(log.t)))
     observer = _core.MomentumObserver(robot, gain, dt)
+    assert log.qd is not None  # measured, or differentiated just above
     r = observer.run(log.q, log.qd, log.tau - offsets)
     return Residual(
         t=log.t.copy(),
@@ -118,7 +122,7 @@ def plot_residual(residual: Residual, path: str | Path, threshold: float | Array
         ax.set_ylabel(f"r{j + 1}")
         ax.text(0.99, 0.9, f"RMS {residual.rms[j]:.3g}", transform=ax.transAxes, ha="right",
                 va="top", fontsize=8)
-    axes[-1, 0].set_xlabel("t - t0 [s]")
+    fig.axes[-1].set_xlabel("t - t0 [s]")  # the bottom panel, axes[-1, 0] (typed as an Axes)
     gains = ", ".join(f"{g:g}" for g in np.unique(residual.gain))
     fig.suptitle(f"momentum-observer residual [N m] (gain {gains} 1/s, dt {residual.dt:.4g} s)")
     fig.tight_layout()

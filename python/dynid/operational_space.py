@@ -34,9 +34,11 @@ from numpy.typing import ArrayLike, NDArray
 from ._checks import real_array
 
 if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
     from .robot import Robot
 
-Array = NDArray[np.float64]
+Array: TypeAlias = NDArray[np.float64]
 
 #: Reciprocal condition number of the unit-diagonal J M^-1 J^T below which q is singular.
 SINGULAR_RCOND = 1e-12
@@ -69,7 +71,8 @@ def _task_mobility(robot: Robot, q: Array, rows: list[int]) -> tuple[Array, Arra
     """J (rows), M and Y = M^-1 J^T for q (n,) or (T, n)."""
     J = robot.jacobian(q)[..., rows, :]
     M = robot.mass_matrix(q)
-    Y = np.linalg.solve(M, np.swapaxes(J, -1, -2))
+    # asarray: NumPy's stubs type linalg results as floating[Any]; float64 in, float64 out
+    Y = np.asarray(np.linalg.solve(M, np.swapaxes(J, -1, -2)), dtype=np.float64)
     return J, M, Y
 
 
@@ -93,7 +96,7 @@ def _inverse_checked(X: Array, rows: list[int]) -> Array:
             "(select fewer rows with rows=..., e.g. rows='position', or move away from the "
             "singularity)"
         )
-    return np.linalg.inv(X)
+    return np.asarray(np.linalg.inv(X), dtype=np.float64)  # typed floating[Any] by NumPy
 
 
 def cartesian_inertia(robot: Robot, q: ArrayLike, rows: str | Sequence[int] | None = None) -> Array:

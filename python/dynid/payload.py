@@ -34,6 +34,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -216,7 +217,7 @@ def payload_from_identified(
     """
     for name, model in (("unloaded", unloaded), ("loaded", loaded)):
         if not isinstance(model, IdentifiedModel):
-            raise ValueError(  # noqa: TRY004 -- SPEC 2
+            raise ValueError(
                 f"{name}: expected a dynid.IdentifiedModel (identify_from_controller), got "
                 f"{type(model).__name__}"
             )
@@ -302,7 +303,7 @@ def _physical(
     parameters_std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     mass, mass_std = float(theta[0]), float(parameters_std[0])
     total = float(np.abs(robot.params[:, 0]).sum()) or 1.0
-    common = {"mass": mass, "mass_std": mass_std, "parameters": theta.copy(),
+    common: dict[str, Any] = {"mass": mass, "mass_std": mass_std, "parameters": theta.copy(),
               "parameters_std": parameters_std, "frame": frame, "fit": fit}
     if not mass > max(SIGNIFICANCE * mass_std, MASS_FLOOR * total):
         return PayloadEstimate(com=None, com_std=None, inertia=None, inertia_std=None, **common)

@@ -48,8 +48,16 @@ from numpy.typing import ArrayLike, NDArray
 from ._checks import positive
 from ._equality import ValueEquality
 from .base_parameters import base_parameters
-from .physical_arguments import (check_count, check_data, check_flag, check_mass_bounds,
-                                 check_prior, check_prior_weight, check_total_mass, check_weights)
+from .physical_arguments import (
+    check_count,
+    check_data,
+    check_flag,
+    check_mass_bounds,
+    check_prior,
+    check_prior_weight,
+    check_total_mass,
+    check_weights,
+)
 from .pseudo_inertia import nearest_with_margin, pseudo_inertia, standard_from_pseudo_inertia
 from .robot import Robot
 
@@ -174,7 +182,7 @@ def physical_least_squares(
 
     started = time.perf_counter()
     if not isinstance(robot, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     rotor, friction = check_flag(rotor, "rotor"), check_flag(friction, "friction")
     n = robot.n
@@ -207,6 +215,7 @@ def physical_least_squares(
     constraints = [Ji - margin * np.eye(4) >> 0 for Ji in J]
     masses = cp.hstack([Ji[3, 3] for Ji in J])
     if lower is not None:
+        assert upper is not None  # check_mass_bounds gives both or neither
         constraints += [masses >= lower]
         finite = np.isfinite(upper)
         if finite.any():

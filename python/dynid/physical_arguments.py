@@ -62,7 +62,7 @@ def check_prior(prior: Any, robot: Robot, rotor: bool, friction: bool) -> NDArra
     keeps every link frame), else re-expressed by :func:`dynid.link_frames.express_in_frames_of`
     (e.g. a URDF's or the other convention's table of the same arm)."""
     if not isinstance(prior, Robot):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"prior: expected a dynid.Robot, got {type(prior).__name__}")
     if (prior.n, prior.joint_types) != (robot.n, robot.joint_types):
         raise ValueError(

@@ -37,8 +37,8 @@ def plot_joint_signals(t: ArrayLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike
     """Positions, velocities and accelerations of all joints (as the paper's Fig. 3)."""
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
     fig.suptitle(title)
-    for ax, data, label in zip(axes, (q, qd, qdd), ("q [rad]", "qd [rad/s]", "qdd [rad/s²]")):
-        data = np.asarray(data)
+    for ax, signal, label in zip(axes, (q, qd, qdd), ("q [rad]", "qd [rad/s]", "qdd [rad/s²]")):
+        data = np.asarray(signal)
         for j in range(data.shape[1]):
             ax.plot(t, data[:, j], lw=1, label=f"J{j + 1}")
         ax.set_ylabel(label)

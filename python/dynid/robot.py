@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -80,12 +81,13 @@ class Robot(_core.Model):
         name
             A label for printing.
         """
+        expected = "dh: expected shape (n, 4) with rows [a, alpha, d, theta], got"
         try:
             shape = np.shape(dh)
         except ValueError:
-            shape = "a ragged sequence"
+            raise ValueError(f"{expected} a ragged sequence") from None
         if isinstance(dh, str) or len(shape) != 2:
-            raise ValueError(f"dh: expected shape (n, 4) with rows [a, alpha, d, theta], got {shape}")
+            raise ValueError(f"{expected} {shape}")
         n = shape[0]
         if joint_types is None:
             joint_types = "R" * n
@@ -219,7 +221,7 @@ class Robot(_core.Model):
         return names
 
     # ---- copies, pickling, equality (multiprocessing, Dask and Ray pickle what they send) -----
-    def _state(self) -> dict[str, object]:
+    def _state(self) -> dict[str, Any]:
         """Everything that defines the robot (derived caches such as base parameters excluded)."""
         return {
             "dh": self.dh, "joint_types": self.joint_types, "convention": self.convention,
@@ -228,7 +230,7 @@ class Robot(_core.Model):
             "Ia": self.Ia, "Fv": self.Fv, "Fs": self.Fs,
         }
 
-    def __reduce__(self) -> tuple[object, tuple[dict[str, object]]]:
+    def __reduce__(self) -> tuple[object, tuple[dict[str, Any]]]:
         return (_robot_from_state, (self._state(),))
 
     def __eq__(self, other: object) -> bool:
@@ -240,7 +242,8 @@ class Robot(_core.Model):
         return all(np.array_equal(mine[k], theirs[k]) if isinstance(mine[k], np.ndarray)
                    else mine[k] == theirs[k] for k in mine)
 
-    __hash__ = None  # type: ignore[assignment]  # parameters are settable
+    # Unhashable (parameters are settable); mypy objects to None in place of the inherited method.
+    __hash__ = None  # type: ignore[assignment]
 
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""
@@ -328,11 +331,11 @@ class Robot(_core.Model):
         return low + (high - low) * rng.random((count, self.n))
 
 
-def _robot_from_state(state: dict[str, object]) -> Robot:
+def _robot_from_state(state: dict[str, Any]) -> Robot:
     """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
-    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],  # type: ignore[arg-type]
-                          state["gravity"], state["params"], state["base"], state["tool"],  # type: ignore[arg-type]
-                          state["qlim"], state["name"])  # type: ignore[arg-type]
+    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],
+                          state["gravity"], state["params"], state["base"], state["tool"],
+                          state["qlim"], state["name"])
     robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
     return robot
 

@@ -16,7 +16,7 @@ Every function works along ``axis`` (default 0, the time axis of a (T, n) trajec
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -50,7 +50,7 @@ def _array(x: ArrayLike, name: str, min_ndim: int = 1) -> NDArray[np.float64]:
 
 def _axis(x: NDArray, axis: int, name: str = "x") -> int:
     if not is_integer(axis):
-        raise ValueError(f"axis: expected an integer, got {axis!r}")  # noqa: TRY004
+        raise ValueError(f"axis: expected an integer, got {axis!r}")
     if not -x.ndim <= axis < x.ndim:
         raise ValueError(f"axis: {axis} is out of range for {name} with shape {x.shape}")
     return int(axis) % x.ndim
@@ -69,8 +69,12 @@ def _per_column(value: ArrayLike, name: str, columns: int, what: str) -> NDArray
     return array
 
 
+#: How scipy.signal.sosfiltfilt extends the signal at the ends.
+PadType = Literal["odd", "even", "constant"]
+
+
 def _sosfiltfilt(
-    x: NDArray, sos: NDArray, axis: int, order: int, name: str, padtype: str = "odd",
+    x: NDArray, sos: NDArray, axis: int, order: int, name: str, padtype: PadType = "odd",
     padlen: int | None = None,
 ) -> NDArray:
     """sosfiltfilt with a readable error when x is shorter than the filter's edge padding."""
@@ -93,7 +97,7 @@ def _sosfiltfilt(
 
 
 def lowpass(
-    x: ArrayLike, fs: float, cutoff: float, order: int = 4, axis: int = 0, padtype: str = "odd",
+    x: ArrayLike, fs: float, cutoff: float, order: int = 4, axis: int = 0, padtype: PadType = "odd",
     settle: bool = False,
 ) -> NDArray:
     """Zero-phase low-pass Butterworth filter (forward and backward, ``sosfiltfilt``).
@@ -194,6 +198,7 @@ def differentiate(
     if fs is not None:
         step = 1.0 / positive(fs, "fs")
         return _finite_result(np.gradient, arr, step, axis=ax, edge_order=edge_order)
+    assert t is not None  # exactly one of t and fs (checked above)
     t = check_time(t)
     if t.size != length:
         raise ValueError(f"t: has {t.size} samples but x has {length} along axis {ax}")
@@ -227,7 +232,8 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
     folding back onto low frequencies; the cutoff is relative, so arrays need no sampling rate.
     Pass ``antialias=False`` only for signals already band-limited below that (e.g. a log
     low-passed at a lower cutoff). A time vector must not be filtered: subsample
-    ``t[::factor]`` yourself, or decimate a whole log with :func:`dynid.io.preparation.decimate_log`.
+    ``t[::factor]`` yourself, or decimate a whole log with
+    :func:`dynid.io.preparation.decimate_log`.
     """
     if factor is None and len(data) >= 2 and is_integer(data[-1]):
         data, factor = data[:-1], data[-1]
@@ -286,7 +292,7 @@ def moving_mask_min_velocity(
     mask = np.abs(columns) >= thr
     if per_joint:
         return mask if qd.ndim == 2 else mask[:, 0]
-    return mask.all(axis=1)
+    return np.all(mask, axis=1)
 
 
 def outlier_mask(

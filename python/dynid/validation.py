@@ -33,11 +33,11 @@ def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArra
     # so that the squares of values beyond ~1e154 do not overflow; scaled back at the end.
     largest = max(float(np.abs(measured).max()), float(np.abs(predicted).max()))
     exponent = int(np.frexp(largest)[1]) if largest > 0 else 0
-    measured, predicted = np.ldexp(measured, -exponent), np.ldexp(predicted, -exponent)
-    error = predicted - measured
+    y: NDArray[np.float64] = np.ldexp(measured, -exponent)  # measured, scaled
+    error: NDArray[np.float64] = np.ldexp(predicted, -exponent) - y
     sse = np.sum(error**2, axis=0)
-    sst = np.sum((measured - measured.mean(axis=0)) ** 2, axis=0)
-    rms_measured = np.sqrt(np.mean(measured**2, axis=0))
+    sst = np.sum((y - y.mean(axis=0)) ** 2, axis=0)
+    rms_measured = np.sqrt(np.mean(y**2, axis=0))
     with np.errstate(divide="ignore", invalid="ignore"):
         r2 = np.where(sst > 0.0, 1.0 - sse / sst, np.where(sse == 0.0, 1.0, -np.inf))
         relative = np.where(rms_measured > 0.0, np.sqrt(np.mean(error**2, axis=0)) / rms_measured,

@@ -10,5 +10,6 @@ namespace dynid {
 // about fixed axes and add nothing, notes "Resulting dynamic model").
 void coriolis(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
               VectorOut c);
+// q, qd, c: n entries each; std::invalid_argument naming the argument (or ws) otherwise.
 
 }  // namespace dynid

@@ -10,5 +10,6 @@ namespace dynid {
 
 void coriolis_matrix(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
                      MatrixOut S);
+// q, qd: n entries, S: n x n; std::invalid_argument naming the argument (or ws) otherwise.
 
 }  // namespace dynid

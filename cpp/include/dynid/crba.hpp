@@ -6,10 +6,8 @@
 
 namespace dynid {
 
-// M(q) = B(q) + diag(Ia), full symmetric n x n.
+// M(q) = B(q) + diag(Ia), full symmetric n x n. q has n entries, M is n x n; throws
+// std::invalid_argument naming the argument (or ws) that does not fit the model.
 void crba(const Model& model, Workspace& ws, const VectorIn& q, MatrixOut M);
-
-// B(q) only, for joint transforms already in ws.X (no rotor inertia).
-void composite_rigid_body(const Model& model, Workspace& ws, MatrixOut B);
 
 }  // namespace dynid

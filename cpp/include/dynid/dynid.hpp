@@ -1,4 +1,5 @@
 // Everything a C++ user needs: build a Model, make a Workspace per thread, call the algorithms.
+// Every public header is included here; dynid/detail/ holds the internals (not API).
 #pragma once
 
 #include "dynid/controllers.hpp"
@@ -14,9 +15,12 @@
 #include "dynid/kinematics.hpp"
 #include "dynid/model.hpp"
 #include "dynid/momentum_observer.hpp"
+#include "dynid/recursive_least_squares.hpp"
 #include "dynid/regressor.hpp"
+#include "dynid/rigid_body.hpp"
 #include "dynid/rnea.hpp"
 #include "dynid/rnea_derivatives.hpp"
 #include "dynid/rnea_time_derivatives.hpp"
 #include "dynid/simulator.hpp"
+#include "dynid/types.hpp"
 #include "dynid/workspace.hpp"

@@ -71,7 +71,7 @@ class ElasticSimulator {
   const ElasticDrives& drives_;
   double dt_, coulomb_band_;
   int substeps_;
-  Workspace ws_;
+  Workspace workspace_;
   VectorX x_, tau_, tau_J_, k1_, k2_, k3_, k4_, stage_;
 };
 

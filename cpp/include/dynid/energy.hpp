@@ -14,4 +14,6 @@ double kinetic_energy(const Model& model, Workspace& ws, const VectorIn& q, cons
 // U = -sum_i g^T (m_i p_i + R_i h_i) in world coordinates, zero at the world origin.
 double potential_energy(const Model& model, Workspace& ws, const VectorIn& q);
 
+// q, qd: n entries each; std::invalid_argument naming the argument (or ws) otherwise.
+
 }  // namespace dynid

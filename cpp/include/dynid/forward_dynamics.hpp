@@ -6,6 +6,7 @@
 
 namespace dynid {
 
+// q, qd, tau, qdd: n entries each (std::invalid_argument naming the argument or ws otherwise).
 // Throws std::domain_error when M(q) is not positive definite (inconsistent parameters).
 void forward_dynamics(const Model& model, Workspace& ws, const VectorIn& q, const VectorIn& qd,
                       const VectorIn& tau, VectorOut qdd);

@@ -6,6 +6,7 @@
 
 namespace dynid {
 
+// q, g: n entries each; std::invalid_argument naming the argument (or ws) otherwise.
 void gravity(const Model& model, Workspace& ws, const VectorIn& q, VectorOut g);
 
 }  // namespace dynid

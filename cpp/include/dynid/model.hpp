@@ -1,11 +1,23 @@
-// The immutable description of a serial arm: its DH table, gravity, base and tool transforms,
-// standard inertial parameters (SPEC section 2) and drive terms. Algorithms read it through a
-// const reference; every per-call buffer lives in a Workspace, so one Model serves many threads.
+// The description of a serial arm: its DH table, gravity, base and tool transforms, standard
+// inertial parameters (SPEC section 2) and drive terms. Every per-call buffer lives in a
+// Workspace, so one Model serves many threads.
+//
+// Mutability and threads. A Model is a value: it is built from a DH table and completed with the
+// setters below (set_link, set_parameters, set_rotor_inertia, ...), each of which checks its
+// argument (std::invalid_argument naming it) and recomputes the derived quantities. The number
+// of joints never changes. The algorithms take it by const reference and only read it, so any
+// number of threads may evaluate the same Model at once, each with its own Workspace. A setter
+// is a write: calling one while another thread evaluates the same Model is a data race (nothing
+// inside is locked or atomic). To change a model that other threads are using, change a copy and
+// hand the copy over between calls (the Python binding does exactly this: a setter replaces a
+// std::shared_ptr<const Model>, so a batch already running keeps the model it started with). A
+// Workspace depends only on n() and stays valid across every setter.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "dynid/detail/joint_geometry.hpp"
 #include "dynid/rigid_body.hpp"
 #include "dynid/types.hpp"
 
@@ -23,32 +35,6 @@ struct DHRow {
   double d = 0.0;
   double theta = 0.0;
   JointType type = JointType::Revolute;
-};
-
-// DH frame i relative to joint frame J_i: Tx(a) Rx(alpha) (standard DH), identity (modified).
-struct LinkOffset {
-  bool identity = true;
-  double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
-
-  Matrix3 rotation() const {  // Rx(alpha)
-    Matrix3 R;
-    R << 1.0, 0.0, 0.0, 0.0, cos_alpha, -sin_alpha, 0.0, sin_alpha, cos_alpha;
-    return R;
-  }
-  Vector3 translation() const { return Vector3(a, 0.0, 0.0); }
-
-  // Rx(alpha)^T x: a vector of J_i in the axes of DH frame i.
-  Vector3 rotate_to_link(const Vector3& x) const {
-    return Vector3(x.x(), cos_alpha * x.y() + sin_alpha * x.z(),
-                   -sin_alpha * x.y() + cos_alpha * x.z());
-  }
-};
-
-// Constant part of joint i in the modified form used by the algorithms (joint_transform.hpp).
-struct JointGeometry {
-  double cos_alpha = 1.0, sin_alpha = 0.0, a = 0.0;
-  double theta = 0.0, d = 0.0;  // offsets to which q adds
-  bool revolute = true;
 };
 
 class Model {
@@ -70,6 +56,9 @@ class Model {
   const MatrixX& parameters() const { return parameters_; }
   void set_parameters(const Eigen::Ref<const MatrixX>& parameters);
   void set_link(int i, const RigidBodyParameters& body);
+  // Why link i (0-based) cannot exist as a rigid body ("" when it can): its standard parameters
+  // checked by physical_inconsistency (rigid_body.hpp). std::invalid_argument for i out of range.
+  std::string link_inconsistency(int i) const;
 
   // Drive terms (n each): rotor inertia reflected to the link side, viscous and Coulomb friction.
   const VectorX& rotor_inertia() const { return Ia_; }
@@ -79,12 +68,13 @@ class Model {
   void set_viscous_friction(const VectorIn& Fv);
   void set_coulomb_friction(const VectorIn& Fs);
 
-  // ---- derived quantities the algorithms use ----
-  const JointGeometry& joint(int i) const { return joints_[i]; }
+  // ---- derived quantities: the algorithms' view (unchecked index; its types are in
+  // dynid::detail and may change between releases) ----
+  const detail::JointGeometry& joint(int i) const { return joints_[i]; }
   // Link i's parameters about the origin of its joint frame J_i.
   const RigidBodyParameters& body(int i) const { return bodies_[i]; }
   // DH frame i = J_i * link_offset(i): identity for modified DH, Tx(a_i) Rx(alpha_i) for standard.
-  const LinkOffset& link_offset(int i) const { return offsets_[i]; }
+  const detail::LinkOffset& link_offset(int i) const { return offsets_[i]; }
   // Gravity expressed in frame 0 (the base frame).
   const Vector3& gravity_base() const { return gravity_base_; }
   // Frame J_n -> tool: link_offset(n-1) * tool.
@@ -102,9 +92,9 @@ class Model {
   MatrixX parameters_;
   VectorX Ia_, Fv_, Fs_;
 
-  std::vector<JointGeometry> joints_;
+  std::vector<detail::JointGeometry> joints_;
   std::vector<RigidBodyParameters> bodies_;
-  std::vector<LinkOffset> offsets_;
+  std::vector<detail::LinkOffset> offsets_;
   Vector3 gravity_base_;
   Matrix4 flange_to_tool_;
 };

@@ -65,7 +65,14 @@ class RecursiveLeastSquares {
 
   // One block: Y_k is m x p, tau_k has m entries (any m >= 1). Throws std::invalid_argument on
   // mismatched sizes; the values are not checked here (the Python binding rejects NaN/inf).
+  // Values too large for double precision (|Y|, |tau| around 1e150 and beyond) overflow the
+  // estimate or the covariance factors to inf/NaN: check is_finite() after updates with data
+  // that may be that large, and reset() when it is false (the Python binding checks after every
+  // call and restores the state from before it).
   void update(const MatrixIn& Y_k, const VectorIn& tau_k);
+
+  // True when theta and the covariance factors U, D are all finite (O(p^2) reads, no allocation).
+  bool is_finite() const { return theta_.allFinite() && D_.allFinite() && U_.allFinite(); }
 
   int p() const { return p_; }
   double forgetting() const { return lambda_; }

@@ -8,7 +8,11 @@
 
 namespace dynid {
 
+// P, the columns of regressor(): 10n, plus n with rotor, plus 2n with friction.
 int regressor_columns(int n, bool rotor, bool friction);
+
+// The three regressors check q, qd, qdd (n entries) and the output's shape (given with each)
+// and throw std::invalid_argument naming the argument (or ws) that does not fit the model.
 
 // Y(q, qd, qdd) (n x P) with Y pi == rnea(q, qd, qdd). Block upper triangular: the row of joint i
 // has zeros in the columns of links j < i.

@@ -41,4 +41,8 @@ struct RigidBodyParameters {
 // inequalities.
 std::string physical_inconsistency(double mass, const Matrix3& inertia_com);
 
+// The same for a body given by its standard parameters (about any frame origin): its inertia is
+// moved to the centre of mass first (inverse Steiner), which needs m > 0.
+std::string physical_inconsistency(const RigidBodyParameters& body);
+
 }  // namespace dynid

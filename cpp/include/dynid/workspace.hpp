@@ -1,71 +1,36 @@
 // Every buffer an evaluation needs, sized once for a model. Algorithms write here instead of
-// allocating, so a sample costs no heap allocation; give each thread its own Workspace.
+// allocating, so a sample costs no heap allocation; give each thread its own Workspace
+// (Pinocchio's Model/Data split). Its contents are internal (detail/workspace_buffers.hpp): a
+// Workspace is only made, passed to the algorithms and asked for n().
 #pragma once
 
-#include <Eigen/Cholesky>
-#include <vector>
-
-#include "dynid/detail/derivative_buffers.hpp"
-#include "dynid/detail/time_derivative_buffers.hpp"
-#include "dynid/joint_transform.hpp"
+#include "dynid/detail/workspace_buffers.hpp"
 #include "dynid/model.hpp"
-#include "dynid/rigid_body.hpp"
-#include "dynid/types.hpp"
 
 namespace dynid {
 
-struct Workspace {
-  explicit Workspace(const Model& model);
+class Workspace;
 
-  // Per-link arrays hold n + 1 entries: index 0 is the base (frame 0), index i is link i
-  // (1-based, as in the notes); X[i] is joint i.
-  int n;
-  // Joint transforms J_{i-1} -> J_i at the current q (kinematics.hpp).
-  std::vector<JointTransform> X;
+namespace detail {
+// The algorithms' access to the buffers (not API).
+WorkspaceBuffers& buffers(Workspace& ws);
+}  // namespace detail
 
-  // Newton-Euler recursion, all in the joint frames J_i: angular velocity and acceleration,
-  // linear velocity and acceleration of the frame origin, force and moment (about the origin)
-  // that link i-1 exerts on link i.
-  std::vector<Vector3> omega, omegad, v, a, f, mu;
+class Workspace {
+ public:
+  // Allocates every buffer for a model of model.n() joints. The Workspace depends on n only: it
+  // serves any Model with the same number of joints, and stays valid when the model's
+  // parameters, gravity, base or tool change.
+  explicit Workspace(const Model& model) : buffers_(model.n()) {}
 
-  // World poses of the joint frames (rotation, origin).
-  std::vector<Matrix3> R_world;
-  std::vector<Vector3> p_world;
+  // Joints of the models this workspace serves; every algorithm checks it against model.n().
+  int n() const { return buffers_.n; }
 
-  // CRBA: composite bodies in the joint frames (mass, first moment, the six entries of the
-  // symmetric inertia xx, xy, xz, yy, yz, zz about the frame origin).
-  struct Composite {
-    double m;
-    Vector3 h;
-    double I[6];
-  };
-  std::vector<Composite> composite;
-
-  // Coriolis matrix (coriolis_matrix.cpp): world-frame joint axes (motion subspaces) and their
-  // time derivatives, and per link the sums over the outboard links of the spatial inertias and
-  // of the Coriolis factors' non-zero blocks (a 3x3 block and a momentum vector).
-  std::vector<Vector6> axis_world, axis_world_dot;
-  std::vector<RigidBodyParameters> inertia_sum;
-  std::vector<Matrix3> coriolis_block_sum;
-  std::vector<Vector3> momentum_sum;
-  std::vector<Vector6> column_wrench, row_inertia;
-  std::vector<Vector3> row_coriolis;
-
-  // Regressors: the joint axes i <= j as spatial motion vectors [s; l] in the frame of link j's
-  // parameters.
-  std::vector<Vector6> axes;
-
-  // Forward dynamics and scratch.
-  VectorX zeros;  // n zeros, for the recursions called without velocity or acceleration
-  MatrixX M;
-  VectorX bias;
-  Eigen::LLT<MatrixX> cholesky;
-
-  // Analytic derivatives (rnea_derivatives.cpp).
-  detail::DerivativeBuffers derivatives;
-
-  // Time derivatives of inverse dynamics (rnea_time_derivatives.cpp).
-  detail::TimeDerivativeBuffers time_derivatives;
+ private:
+  friend detail::WorkspaceBuffers& detail::buffers(Workspace& ws);
+  detail::WorkspaceBuffers buffers_;
 };
+
+inline detail::WorkspaceBuffers& detail::buffers(Workspace& ws) { return ws.buffers_; }
 
 }  // namespace dynid

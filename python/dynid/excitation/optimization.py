@@ -11,6 +11,7 @@ inequalities; only the objective is nonlinear. SLSQP minimises it with the analy
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -129,7 +130,7 @@ def optimize_excitation(
     objective = _LogCondition(robot, base, t, wf, harmonics, rotor, friction)
     m = min(samples, CONSTRAINT_POINTS_PER_HARMONIC * harmonics)
     grid = _basis(period * np.arange(m) / m, wf, harmonics)
-    constraints = [_inequalities(grid, n, low, high, vel, acc)]
+    constraints: list[Any] = [_inequalities(grid, n, low, high, vel, acc)]  # SciPy's dicts
     if at_rest:
         constraints.append(_rest_equalities(n, harmonics))
     x0 = start.to_vector()
@@ -343,7 +344,7 @@ def _check_initial(
 ) -> FourierTrajectory:
     if not isinstance(initial, FourierTrajectory):
         # SPEC section 2: a wrong type is a ValueError too
-        raise ValueError(  # noqa: TRY004
+        raise ValueError(
             f"initial: expected a FourierTrajectory, got {type(initial).__name__}"
         )
     if (initial.n, initial.harmonics) != (n, harmonics) or not np.isclose(initial.period, period):

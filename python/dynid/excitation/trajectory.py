@@ -21,6 +21,7 @@ parameters (kg against kg m^2) rather than how well the motion excites them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -222,10 +223,7 @@ def excitation_condition_number(
     _, q, qd, qdd = trajectory.sample(count)
     W = base.reduce(robot.regressor(q, qd, qdd, rotor=rotor, friction=friction))
     W = W.reshape(-1, base.count)
-    if scaled:
-        s = _scaled_singular_values(W)[2]
-    else:
-        s = np.linalg.svd(W, compute_uv=False)[::-1]
+    s = _scaled_singular_values(W)[2] if scaled else np.linalg.svd(W, compute_uv=False)[::-1]
     return float(s[-1] / s[0]) if s[0] > 0 else float("inf")
 
 
@@ -246,7 +244,8 @@ def _scaled_singular_values(W: NDArray[np.float64]) -> tuple[NDArray[np.float64]
 
 
 def _basis(t: NDArray[np.float64], wf: float, harmonics: int) -> tuple[NDArray[np.float64], ...]:
-    """(T, 2H) matrices mapping the coefficients [a_i | b_i] of a joint to q_i - q0_i, qd_i, qdd_i."""
+    """(T, 2H) matrices mapping the coefficients [a_i | b_i] of a joint to q_i - q0_i, qd_i and
+    qdd_i."""
     w = wf * np.arange(1, harmonics + 1)
     S, C = np.sin(np.outer(t, w)), np.cos(np.outer(t, w))
     return np.hstack([S / w, -C / w]), np.hstack([C, S]), np.hstack([-S * w, C * w])
@@ -286,7 +285,12 @@ def _finite_array(value: ArrayLike, name: str) -> NDArray[np.float64]:
 
 
 def _finite_positive(value: object, name: str) -> float:
-    array = _finite_array(value, name) if not isinstance(value, bool) else np.array(np.nan)
+    # Any object goes to real_array, which raises the ValueError naming it for non-numbers.
+    array = (
+        _finite_array(cast(ArrayLike, value), name)
+        if not isinstance(value, bool)
+        else np.array(np.nan)
+    )
     if array.ndim != 0 or not array > 0.0:
         raise ValueError(f"{name}: expected a positive finite number, got {value!r}")
     return float(array)

@@ -76,7 +76,7 @@ class Log(ValueEquality):
             if arr.ndim != 2:
                 raise ValueError(f"{name}: expected shape (T, n), got {arr.shape}")
             setattr(self, name, arr)
-        lengths = {name: len(getattr(self, name)) for name in ("t",) + SIGNALS
+        lengths = {name: len(getattr(self, name)) for name in ("t", *SIGNALS)
                    if getattr(self, name) is not None}
         if len(set(lengths.values())) > 1:
             listed = ", ".join(f"{k} has {v}" for k, v in lengths.items())
@@ -90,7 +90,7 @@ class Log(ValueEquality):
                 )
         if n < 1:
             raise ValueError("q: has no joints (0 columns)")
-        for name in ("t",) + SIGNALS:
+        for name in ("t", *SIGNALS):
             value = getattr(self, name)
             if value is not None:
                 _check_finite(value, name)
@@ -133,7 +133,7 @@ class Log(ValueEquality):
         unknown = set(arrays) - {"t", *SIGNALS}
         if unknown:
             raise ValueError(f"arrays: unknown names {sorted(unknown)}; expected t, q, tau, qd, qdd")
-        values = {name: getattr(self, name) for name in ("t",) + SIGNALS}
+        values = {name: getattr(self, name) for name in ("t", *SIGNALS)}
         values.update(arrays)
         notes = self.notes + ([note] if note else [])
         return Log(**values, source=self.source, notes=notes)
@@ -155,11 +155,12 @@ class Log(ValueEquality):
             kept = mask.size
         else:
             raise ValueError(
-                f"mask: expected a boolean (T,) mask or 1-D integer indices, got {mask.dtype} {mask.shape}"
+                f"mask: expected a boolean (T,) mask or 1-D integer indices, got {mask.dtype} "
+                f"{mask.shape}"
             )
         if note is None:
             note = f"selected {kept} of {self.T} samples"
-        arrays = {name: getattr(self, name)[mask] for name in ("t",) + SIGNALS
+        arrays = {name: getattr(self, name)[mask] for name in ("t", *SIGNALS)
                   if getattr(self, name) is not None}
         return self.replace(note=note, **arrays)
 
@@ -196,7 +197,9 @@ def _check_finite(arr: NDArray, name: str, rows: NDArray | None = None) -> None:
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.nonzero(bad.reshape(len(arr), -1).any(axis=1))[0][0])
-        cols = np.nonzero(bad[i].ravel())[0] + 1 if arr.ndim == 2 else []
+        cols: NDArray[np.intp] | list[int] = (
+            np.nonzero(bad[i].ravel())[0] + 1 if arr.ndim == 2 else []
+        )
         joint = f", joint(s) {', '.join(str(c) for c in cols)}" if len(cols) else ""
         where = f"row {i}" if rows is None else f"line {rows[i]} (data row {i})"
         raise ValueError(f"{name}: non-finite value at {where}{joint}")
@@ -302,11 +305,12 @@ def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     with data:
         found = list(data.files)
         _check_npz_members(path)
+        arrays: dict[str, Any]
         if mapping is not None:
             arrays = _mapped_arrays(found, data.__getitem__, mapping)
             note = f"loaded from {path.name} (NPZ, columns {dict(mapping)})"
             return Log(**arrays, source=str(path), notes=[note])
-        arrays: dict[str, Any] = {}
+        arrays = {}
         flobaroid = False
         for name, aliases in NPZ_KEYS.items():
             present = [key for key in aliases if key in found]
@@ -330,7 +334,7 @@ def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
             raise ValueError(f"key for {name}: expected numbers, got dtype {arr.dtype}")
     how = "FloBaRoID key names" if flobaroid else "dynid key names"
     note = f"loaded from {path.name} (NPZ, {how}; {', '.join(arrays)})"
-    return Log(**arrays, source=str(path), notes=notes + [note])
+    return Log(**arrays, source=str(path), notes=[*notes, note])
 
 
 def _check_npz_members(path: Path) -> None:
@@ -413,10 +417,11 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
 def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     header, values, lines, notes = _read_csv_table(path)
     index = {name: c for c, name in enumerate(header)}
+    arrays: dict[str, Any]
     if mapping is not None:
         arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping)
         note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
-        return Log(**arrays, source=str(path), notes=notes + [note])
+        return Log(**arrays, source=str(path), notes=[*notes, note])
     if "t" not in index:
         raise ValueError(f"missing column 't'; found columns: {', '.join(header)}")
     groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
@@ -427,7 +432,7 @@ def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     if not groups["q"]:
         raise ValueError(f"missing columns q1..qn; found columns: {', '.join(header)}")
     n = max(groups["q"])
-    arrays: dict[str, Any] = {"t": values[:, index["t"]]}
+    arrays = {"t": values[:, index["t"]]}
     for name, columns in groups.items():
         if not columns:
             if name == "tau":
@@ -462,7 +467,7 @@ def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     note = f"loaded from {path.name} (CSV, {', '.join(arrays)})"
     if ignored:
         note += f"; ignored columns {', '.join(ignored)}"
-    return Log(**arrays, source=str(path), notes=notes + [note])
+    return Log(**arrays, source=str(path), notes=[*notes, note])
 
 
 # --------------------------------------------------------------------------- saving
@@ -476,7 +481,7 @@ def save_log(log: Log, path: PathLike) -> None:
     ``# note:`` lines in CSV) and come back on loading.
     """
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     path = Path(path)

@@ -1,4 +1,5 @@
-"""Robot models from files: a DH table in JSON (or YAML, when PyYAML is installed) or a built-in name.
+"""Robot models from files: a DH table in JSON (or YAML, when PyYAML is installed), or a
+built-in name.
 
 A model file is one object (format in ``docs/cli.md``)::
 
@@ -113,7 +114,7 @@ def save_model(robot: Robot, path: PathLike) -> Path:
 def model_from_dict(data: Any) -> Robot:
     """A Robot from the parsed content of a model file (see the module docstring)."""
     if not isinstance(data, Mapping):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"expected an object with the model's fields, got {type(data).__name__}"
         )
     unknown = [str(k) for k in data if k not in FIELDS and k not in METADATA]
@@ -144,7 +145,7 @@ def model_from_dict(data: Any) -> Robot:
         raise ValueError(f"name: expected a string, got {name!r}")
     joint_types = data.get("joint_types", "R" * n)
     if not isinstance(joint_types, str):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"joint_types: expected a string of R/P letters, got {joint_types!r}"
         )
     arrays = {
@@ -195,7 +196,7 @@ def _row(row: Any, i: int, convention: str) -> list[float]:
     if isinstance(row, list):
         return _numbers(row, where, (4,)).tolist()
     if not isinstance(row, Mapping):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"{where}: expected an object {{a, alpha, d, theta}} or a list of 4 numbers, "
             f"got {row!r:.60}"
         )
@@ -289,7 +290,8 @@ def _load_yaml(text: str, path: Path) -> Any:
     bytes of nested aliases (a "billion laughs" file) would otherwise expand to gigabytes."""
     yaml = _yaml(path)
 
-    class BoundedLoader(yaml.SafeLoader):  # type: ignore[name-defined,misc]
+    # yaml is a module object here (imported on demand), which mypy cannot use as a base class.
+    class BoundedLoader(yaml.SafeLoader):  # type: ignore[name-defined]
         aliases = 0
 
         def compose_node(self, parent: Any, index: Any) -> Any:
@@ -300,7 +302,7 @@ def _load_yaml(text: str, path: Path) -> Any:
             return super().compose_node(parent, index)
 
     try:
-        data = yaml.load(text, Loader=BoundedLoader)  # noqa: S506 -- a SafeLoader subclass
+        data = yaml.load(text, Loader=BoundedLoader)
     except yaml.YAMLError as exc:
         raise ValueError(f"not valid YAML ({exc})".replace("\n", " ")) from None
     _check_expanded_size(data)

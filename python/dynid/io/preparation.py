@@ -68,7 +68,7 @@ def prepare_log(
     Sample removals come last because filters, derivatives and decimation need the uniform grid.
     """
     if not isinstance(log, Log):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"log: expected a dynid.io.Log, got {type(log).__name__}"
         )
     if differentiate not in ("missing", "always", "never"):
@@ -101,13 +101,13 @@ def prepare_log(
             )
     index = np.arange(log.T)  # original sample numbers of the rows still present
     fs = log.fs
-    spikes = np.zeros(log.T, dtype=bool)
+    spikes: NDArray[np.bool_] = np.zeros(log.T, dtype=bool)
     removals: list[tuple[NDArray[np.bool_], str]] = []  # (rows to drop, why), on the final grid
 
     # 1. spikes on the raw torque
     if outlier_k is not None and reference_tau is None:
         flags, smoothed = sig.spike_mask(log.tau, fs, outlier_k)
-        spikes = flags.any(axis=1)
+        spikes = np.any(flags, axis=1)
         if spikes.any():
             log = log.replace(tau=np.where(flags, smoothed, log.tau))
 
@@ -130,7 +130,9 @@ def prepare_log(
     if differentiate != "never" and log.qd is None:
         new["qd"] = sig.differentiate(log.q, log.t)
     if differentiate != "never" and log.qdd is None:
-        new["qdd"] = sig.differentiate(new.get("qd", log.qd), log.t)
+        qd = new.get("qd", log.qd)
+        assert qd is not None  # measured, or differentiated just above
+        new["qdd"] = sig.differentiate(qd, log.t)
     if new:
         source = ("low-passed " if cutoff is not None else "") + ("q" if "qd" in new else "qd")
         note = (
@@ -163,15 +165,17 @@ def prepare_log(
             predicted = reference[index]
             what = "reference_tau (given)"
         else:
-            predicted = real_array(reference_tau(log), "reference_tau(log)")  # type: ignore[operator]
+            assert callable(reference_tau)  # not an array, so the function (checked above)
+            predicted = real_array(reference_tau(log), "reference_tau(log)")
             what = "reference_tau(log)"
             if predicted.shape != log.tau.shape:
                 raise ValueError(
                     f"reference_tau(log): expected shape {log.tau.shape}, got {predicted.shape}"
                 )
         spread = sig.MAD_TO_SIGMA * np.median(np.abs(log.tau - np.median(log.tau, axis=0)), axis=0)
-        flags = sig.outlier_mask(log.tau - predicted, outlier_k,
-                                 min_sigma=sig.SPIKE_FLOOR * spread).any(axis=1)
+        outliers = sig.outlier_mask(log.tau - predicted, outlier_k,
+                                    min_sigma=sig.SPIKE_FLOOR * spread)
+        flags = np.any(outliers, axis=1)
         why = (
             f"whose torque deviates from {what} by more than {outlier_k:g} robust sigmas "
             "(median/MAD per joint)"
@@ -182,8 +186,8 @@ def prepare_log(
     if min_velocity is not None and log.qd is not None:
         moving = sig.moving_mask_min_velocity(log.qd, min_velocity)
         why = (
-            f"with |qd| < {np.round(min_velocity, 6)} on some joint (friction sign ill-defined "
-            "near zero velocity)"
+            f"with |qd| < {np.round(np.asarray(min_velocity), 6)} on some joint (friction sign "
+            "ill-defined near zero velocity)"
         )
         removals.append((~moving, why))
 

@@ -177,7 +177,7 @@ def result_from_dict(data: Any) -> LogIdentification:
     flags = {k: _get(options, k, "options") for k in ("rotor", "friction", "offset")}
     for key, value in flags.items():
         if not isinstance(value, bool):
-            raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+            raise ValueError(
                 f"options.{key}: expected true or false, got {value!r}"
             )
     base = _object(_get(data, "base_parameters"), "base_parameters")
@@ -280,7 +280,7 @@ def _nums(value: Any) -> Any:
 
 def _object(value: Any, where: str) -> dict[str, Any]:
     if not isinstance(value, dict):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"{where}: expected an object, got {type(value).__name__}"
         )
     return dict(value)

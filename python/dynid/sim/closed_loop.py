@@ -94,7 +94,7 @@ def simulate(
         Seed of the torque noise.
     """
     if not isinstance(robot, _core.Model):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: a ValueError naming the argument
+        raise ValueError(
             f"robot: expected a dynid.Robot, got {type(robot).__name__}"
         )
     n = robot.n
@@ -115,7 +115,7 @@ def simulate(
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected 'rk4' or 'euler' (semi-implicit Euler), got {method!r}")
     if not isinstance(friction, (bool, np.bool_)):
-        raise ValueError(f"friction: expected True or False, got {friction!r}")  # noqa: TRY004
+        raise ValueError(f"friction: expected True or False, got {friction!r}")
     coulomb_band = _number(coulomb_band, "coulomb_band", positive=False)
     torque_noise = _number(torque_noise, "torque_noise", positive=False)
     counts = (0.0 if encoder_counts is None
@@ -129,6 +129,7 @@ def simulate(
         robot, q0, qd0, periods, dt, substeps, method, bool(friction), coulomb_band,
         torque_noise, counts, int(seed), record_measured=True, **law,
     )
+    assert q_measured is not None  # asked for with record_measured=True
     return Simulation(t=t, q=q, qd=qd, qdd=qdd, tau=tau, q_measured=q_measured)
 
 
@@ -181,7 +182,7 @@ def _vector(value: ArrayLike, name: str, n: int) -> NDArray[np.float64]:
 def _number(value: Any, name: str, *, positive: bool) -> float:
     bound = "> 0" if positive else ">= 0"
     if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name}: expected a finite number {bound}, got {value!r}")  # noqa: TRY004
+        raise ValueError(f"{name}: expected a finite number {bound}, got {value!r}")
     try:
         number = float(value)
     except (TypeError, ValueError):

@@ -28,10 +28,16 @@ next row is computed, so the table and the frames agree to rounding whatever the
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 
 #: Two axes whose directions differ by less than this angle [rad] count as parallel. A DH table
 #: has no good form for nearly parallel axes: their common normal lies at ~distance / angle, and
@@ -79,13 +85,15 @@ def nearly_parallel(axes: Array) -> list[tuple[int, float]]:
     anti-parallel: the DH table then holds errors of up to ~5e-6 relative (see PARALLEL)."""
     out = []
     for i in range(len(axes) - 1):
-        angle = float(np.arcsin(min(1.0, np.linalg.norm(np.cross(axes[i], axes[i + 1])))))
+        angle = float(np.arcsin(min(1.0, float(np.linalg.norm(np.cross(axes[i], axes[i + 1]))))))
         if NEARLY_PARALLEL[0] < angle < NEARLY_PARALLEL[1]:
             out.append((i, angle))
     return out
 
 
-def _standard_rows(frame: Array, points: Array, axes: Array, tip: Array):
+def _standard_rows(
+    frame: Array, points: Array, axes: Array, tip: Array
+) -> Iterator[tuple[float, float, float, float]]:
     # Frame i-1 has z on axis i; frame i has z on axis i+1, x on the common normal
     # (Spong, Hutchinson, Vidyasagar, "Robot Modeling and Control", ch. 3).
     n = len(axes)
@@ -106,7 +114,9 @@ def _standard_rows(frame: Array, points: Array, axes: Array, tip: Array):
         frame = frame @ dh_standard(a, alpha, d, theta)
 
 
-def _modified_rows(frame: Array, points: Array, axes: Array, tip: Array):
+def _modified_rows(
+    frame: Array, points: Array, axes: Array, tip: Array
+) -> Iterator[tuple[float, float, float, float]]:
     # Frame i has z on axis i, origin on it at the common normal to axis
     # i+1 (Craig, "Introduction to Robotics", ch. 3).
     n = len(axes)

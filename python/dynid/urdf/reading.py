@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,7 +20,10 @@ from numpy.typing import NDArray
 from .frames import PARALLEL, dh_frames, dh_modified, dh_standard, nearly_parallel
 from .tree import MOVABLE, Joint, UrdfTree, read_tree, serial_chain
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 
 
 @dataclass
@@ -40,9 +45,10 @@ class DHModel:
     link_names: list[str]  # child link of each joint
 
 
-def dh_model_from_urdf(urdf, base_link: str | None = None, tip_link: str | None = None,
+def dh_model_from_urdf(urdf: str | Path, base_link: str | None = None, tip_link: str | None = None,
                        convention: str = "standard") -> DHModel:
-    """Read ``urdf`` (a path or the XML text) into a DH model (see :meth:`dynid.Robot.from_urdf`)."""
+    """Read ``urdf`` (a path or the XML text) into a DH model (see
+    :meth:`dynid.Robot.from_urdf`)."""
     if convention not in ("standard", "modified"):
         raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
     tree = read_tree(urdf)
@@ -81,6 +87,7 @@ def _link_parameters(tree: UrdfTree, joints: list[Joint], poses: dict[str, Array
                              "<inertial>, nor has any link fixed to it")
         to_frame = np.linalg.inv(frames[i])
         for link, inertial in inertials:
+            assert inertial is not None  # links without <inertial> were left out above
             params[i] += standard_parameters(inertial.mass, to_frame @ poses[link] @ inertial.origin,
                                              inertial.inertia)
     return params

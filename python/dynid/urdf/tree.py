@@ -13,11 +13,15 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 MOVABLE = ("revolute", "continuous", "prismatic")
 JOINT_TYPES = (*MOVABLE, "fixed", "floating", "planar")
 #: The comment ``to_urdf`` writes inside a joint for its rotor inertia (no URDF field holds it).
@@ -62,7 +66,8 @@ class UrdfTree:
 
 
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> Array:
-    """URDF ``rpy``: fixed-axis rotations about x, then y, then z, i.e. R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    """URDF ``rpy``: fixed-axis rotations about x, then y, then z, i.e.
+    R = Rz(yaw) Ry(pitch) Rx(roll)."""
     cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
                               np.cos(yaw), np.sin(yaw))
     return np.array([
@@ -268,9 +273,12 @@ def _joint(element: ET.Element, links: dict[str, Inertial | None]) -> Joint:
         damping = _number(dynamics, "damping", f"{where} <dynamics>", "0")
         friction = _number(dynamics, "friction", f"{where} <dynamics>", "0")
     rotor = 0.0
-    for comment in element.iter(ET.Comment):
+    # ElementTree tags comments with the Comment factory itself; typeshed types tags as str.
+    for comment in element.iter(ET.Comment):  # type: ignore[arg-type]
         match = ROTOR_COMMENT.search(comment.text or "")
         if match:
             rotor = _number(ET.Element("x", {"Ia": match.group(1)}), "Ia", f"{where} comment")
-    return Joint(name, kind, ends["parent"], ends["child"], _origin(element.find("origin"), where),
+    parent, child = ends["parent"], ends["child"]
+    assert parent is not None and child is not None  # both name links (checked above)
+    return Joint(name, kind, parent, child, _origin(element.find("origin"), where),
                  axis, limits, damping, friction, element.find("mimic") is not None, rotor)

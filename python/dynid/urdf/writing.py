@@ -29,14 +29,17 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .. import _core
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 
 
 def urdf_text(robot: Any, name: str = "robot") -> str:
@@ -64,7 +67,7 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         ET.SubElement(inertial, "origin", xyz=_vector(offset[:3, :3] @ com + offset[:3, 3]),
                       rpy=_vector(rpy(offset[:3, :3])))
         ET.SubElement(inertial, "mass", value=_number(mass))
-        ET.SubElement(inertial, "inertia", **{
+        ET.SubElement(inertial, "inertia", {
             key: _number(inertia[r, c]) for key, (r, c) in
             (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
              ("iyz", (1, 2)), ("izz", (2, 2)))})
@@ -98,7 +101,7 @@ def write_urdf(text: str, path: str | Path, overwrite: bool = False) -> Path:
     """Write ``text`` to ``path`` through a temporary file and a rename (the file is whole or
     absent). An existing file is a ValueError unless ``overwrite``."""
     if not isinstance(overwrite, bool):
-        raise ValueError(  # noqa: TRY004 -- SPEC 2: bad input raises ValueError
+        raise ValueError(
             f"overwrite: expected True or False, got {overwrite!r}")
     if not isinstance(path, (str, Path)) or not str(path).strip():
         raise ValueError(f"path: expected a file path, got {path!r}")

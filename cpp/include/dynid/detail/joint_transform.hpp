@@ -1,4 +1,4 @@
-// One joint of a DH chain in the form every algorithm uses:
+// Internal (dynid::detail, not API): one joint of a DH chain in the form every algorithm uses:
 //   frame J_i = J_{i-1} * Rx(alpha) Tx(a) * Rz(theta) Tz(d)
 // i.e. the modified (Craig) transform. A standard-DH chain is brought to this form by the
 // model (Rx and Tx commute, so Tx(a_{i-1}) Rx(alpha_{i-1}) of row i-1 becomes the constant part of
@@ -10,7 +10,7 @@
 
 #include "dynid/types.hpp"
 
-namespace dynid {
+namespace dynid::detail {
 
 // x_parent = R x_child + p with R = Rx(alpha) Rz(theta), p = Rx(alpha) (a, 0, d).
 struct JointTransform {
@@ -45,4 +45,4 @@ inline void JointTransform::set(double cos_alpha, double sin_alpha, double a, do
   p = Vector3(a, -sa * d, ca * d);
 }
 
-}  // namespace dynid
+}  // namespace dynid::detail
