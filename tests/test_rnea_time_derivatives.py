@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from conftest import ARM_CASES, make_arm
 
 # 8th-order central-difference weights for the first and second derivative (points -4..4).
@@ -111,10 +112,10 @@ def test_bad_arguments_name_the_argument() -> None:
     for k, name in enumerate(names):
         bad = list(good)
         bad[k] = np.zeros(n + 1)
-        with pytest.raises(ValueError, match=f"^{name}:"):
+        with pytest.raises(ValueError, match=rf"^{name}:"):
             robot.rnea_time_derivatives(*bad)
         bad[k] = np.full(n, np.nan)
-        with pytest.raises(ValueError, match=f"^{name}:"):
+        with pytest.raises(ValueError, match=rf"^{name}:"):
             robot.rnea_time_derivatives(*bad)
-    with pytest.raises(ValueError, match="^qdddd:"):
+    with pytest.raises(ValueError, match=r"^qdddd:"):
         robot.rnea_time_derivatives(*good[:4], np.zeros((3, n)))

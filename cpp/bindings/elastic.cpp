@@ -61,26 +61,31 @@ void bind_elastic(py::module_& m) {
   auto model = py::reinterpret_borrow<py::class_<PyModel>>(m.attr("Model"));
   model.def(
       "rnea_time_derivatives",
-      [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle qddd, py::handle qdddd) {
+      [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle qddd,
+         py::handle qdddd) {
         const int n = self.model->n();
         const Samples s = parse_samples(
             {{q, "q"}, {qd, "qd"}, {qdd, "qdd"}, {qddd, "qddd"}, {qdddd, "qdddd"}}, n);
-        // The three vectors of a sample in one block: out[..., 0, :] = tau, 1: tau_dot, 2: tau_ddot.
-        py::array all = evaluate(self, s, {3, n}, [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
-          OutVec tau(out, n), tau_dot(out + n, n), tau_ddot(out + 2 * n, n);
-          rnea_time_derivatives(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n),
-                                ConstVec(in[3], n), ConstVec(in[4], n), tau, tau_dot, tau_ddot);
-        });
+        // The three vectors of a sample in one block: out[..., 0, :] = tau, 1: tau_dot, 2:
+        // tau_ddot.
+        py::array all =
+            evaluate(self, s, {3, n},
+                     [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
+                       OutVec tau(out, n), tau_dot(out + n, n), tau_ddot(out + 2 * n, n);
+                       rnea_time_derivatives(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n),
+                                             ConstVec(in[2], n), ConstVec(in[3], n),
+                                             ConstVec(in[4], n), tau, tau_dot, tau_ddot);
+                     });
         const auto part = [&](int k) {
-          return s.single ? all[py::int_(k)]
-                          : all[py::make_tuple(py::ellipsis(), k, py::slice())];
+          return s.single ? all[py::int_(k)] : all[py::make_tuple(py::ellipsis(), k, py::slice())];
         };
         return py::make_tuple(part(0), part(1), part(2));
       },
       py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("qddd"), py::arg("qdddd"),
       "Inverse dynamics and its exact first and second time derivatives (tau, tau_dot, tau_ddot) "
       "along a motion with joint derivatives qd, qdd, qddd (jerk) and qdddd (snap): (n,) each, or "
-      "(T, n) each for T samples (views into one (3, n) or (T, 3, n) array). tau equals rnea(q, qd, "
+      "(T, n) each for T samples (views into one (3, n) or (T, 3, n) array). tau equals rnea(q, "
+      "qd, "
       "qdd) (links, gravity and drive terms); tau_dot = dtau/dq qd + dtau/dqd qdd + M qddd, "
       "tau_ddot its time derivative. Drive terms are included (Ia qddd + Fv qdd and Ia qdddd + Fv "
       "qddd); Coulomb friction is flat away from qd = 0. Use robot.rigid_body() for the links "
@@ -95,27 +100,31 @@ void bind_elastic(py::module_& m) {
         const int n = links.model->n();
         if (periods < 1) throw py::value_error("duration: expected at least one control period");
         std::shared_ptr<const Model> model = links.model;
-        const ElasticDrives drives{vector_argument(K, "stiffness", n), vector_argument(B, "motor_inertia", n),
-                                   vector_argument(Fv, "motor_viscous", n), vector_argument(Fs, "motor_coulomb", n)};
+        const ElasticDrives drives{
+            vector_argument(K, "stiffness", n), vector_argument(B, "motor_inertia", n),
+            vector_argument(Fv, "motor_viscous", n), vector_argument(Fs, "motor_coulomb", n)};
         ElasticSimulator simulator(*model, drives, dt, substeps, coulomb_band);
         std::unique_ptr<ElasticController> controller;
         if (kind == "callable")
           controller = std::make_unique<PythonElasticController>(function, n);
         else if (kind == "motor_pd")
-          controller = std::make_unique<MotorPDController>(*model, drives, vector_argument(kp, "kp", n),
-                                                           vector_argument(kd, "kd", n), vector_argument(q_d, "q_d", n));
+          controller = std::make_unique<MotorPDController>(
+              *model, drives, vector_argument(kp, "kp", n), vector_argument(kd, "kd", n),
+              vector_argument(q_d, "q_d", n));
         else if (kind == "none")
           controller = std::make_unique<ZeroTorque>();
         else
           throw py::value_error("controller: unknown kind '" + kind + "'");
         const VectorX x_q = vector_argument(q0, "q0", n), x_qd = vector_argument(qd0, "qd0", n);
-        const VectorX x_th = vector_argument(theta0, "theta0", n), x_thd = vector_argument(thetad0, "thetad0", n);
+        const VectorX x_th = vector_argument(theta0, "theta0", n),
+                      x_thd = vector_argument(thetad0, "thetad0", n);
         const py::ssize_t rows = static_cast<py::ssize_t>(periods) + 1, cols = n;
         py::array_t<double> q({rows, cols}), qd({rows, cols}), th({rows, cols}), thd({rows, cols}),
             tau({rows, cols}), tau_J({rows, cols});
-        ElasticSimulationOutput out{RowMajorMap(q.mutable_data(), rows, n), RowMajorMap(qd.mutable_data(), rows, n),
-                                    RowMajorMap(th.mutable_data(), rows, n), RowMajorMap(thd.mutable_data(), rows, n),
-                                    RowMajorMap(tau.mutable_data(), rows, n), RowMajorMap(tau_J.mutable_data(), rows, n)};
+        ElasticSimulationOutput out{
+            RowMajorMap(q.mutable_data(), rows, n),   RowMajorMap(qd.mutable_data(), rows, n),
+            RowMajorMap(th.mutable_data(), rows, n),  RowMajorMap(thd.mutable_data(), rows, n),
+            RowMajorMap(tau.mutable_data(), rows, n), RowMajorMap(tau_J.mutable_data(), rows, n)};
         {
           py::gil_scoped_release release;
           simulator.run(*controller, x_q, x_qd, x_th, x_thd, periods, out);
@@ -123,9 +132,10 @@ void bind_elastic(py::module_& m) {
         return py::make_tuple(q, qd, th, thd, tau, tau_J);
       },
       py::arg("links"), py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
-      py::arg("motor_coulomb"), py::arg("q0"), py::arg("qd0"), py::arg("theta0"), py::arg("thetad0"),
-      py::arg("periods"), py::arg("dt"), py::arg("substeps"), py::arg("coulomb_band"), py::arg("kind"),
-      py::arg("kp"), py::arg("kd"), py::arg("q_d"), py::arg("function"),
+      py::arg("motor_coulomb"), py::arg("q0"), py::arg("qd0"), py::arg("theta0"),
+      py::arg("thetad0"), py::arg("periods"), py::arg("dt"), py::arg("substeps"),
+      py::arg("coulomb_band"), py::arg("kind"), py::arg("kp"), py::arg("kd"), py::arg("q_d"),
+      py::arg("function"),
       "Closed-loop simulation of an elastic-joint robot (use dynid.sim.simulate_elastic): returns "
       "q, qd, theta, thetad, tau, tau_J, each (periods + 1, n).");
 }

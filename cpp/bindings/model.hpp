@@ -22,7 +22,8 @@ struct PyModel {
   std::unique_ptr<Workspace> ws;
 
   explicit PyModel(Model m)
-      : model(std::make_shared<const Model>(std::move(m))), ws(std::make_unique<Workspace>(*model)) {}
+      : model(std::make_shared<const Model>(std::move(m))),
+        ws(std::make_unique<Workspace>(*model)) {}
 
   template <class Change>
   void modify(Change change) {

@@ -26,7 +26,8 @@ void check_drive(const VectorX& v, int n, bool positive, const char* name) {
            std::to_string(v.size());
   });
   require(v.allFinite() && (positive ? (v.array() > 0.0).all() : (v.array() >= 0.0).all()), [&] {
-    return std::string(name) + (positive ? ": expected finite values > 0" : ": expected finite values >= 0");
+    return std::string(name) +
+           (positive ? ": expected finite values > 0" : ": expected finite values >= 0");
   });
 }
 
@@ -67,7 +68,11 @@ void MotorPDController::command(int, double, const VectorIn&, const VectorIn&,
 
 ElasticSimulator::ElasticSimulator(const Model& links, const ElasticDrives& drives, double dt,
                                    int substeps, double coulomb_band)
-    : links_(links), drives_(drives), dt_(dt), coulomb_band_(coulomb_band), substeps_(substeps),
+    : links_(links),
+      drives_(drives),
+      dt_(dt),
+      coulomb_band_(coulomb_band),
+      substeps_(substeps),
       workspace_(links) {
   const int n = links.n();
   check_drive(drives.stiffness, n, true, "stiffness");
@@ -76,7 +81,8 @@ ElasticSimulator::ElasticSimulator(const Model& links, const ElasticDrives& driv
   check_drive(drives.motor_coulomb, n, false, "motor_coulomb");
   require(std::isfinite(dt) && dt > 0.0,
           [&] { return "dt: expected a positive control period, got " + std::to_string(dt); });
-  require(substeps >= 1, [&] { return "substeps: expected >= 1, got " + std::to_string(substeps); });
+  require(substeps >= 1,
+          [&] { return "substeps: expected >= 1, got " + std::to_string(substeps); });
   require(std::isfinite(coulomb_band) && coulomb_band >= 0.0, [&] {
     return "coulomb_band: expected a finite value >= 0, got " + std::to_string(coulomb_band);
   });
@@ -112,8 +118,9 @@ void ElasticSimulator::rate(const VectorIn& x, const VectorIn& tau, VectorOut xd
                                                : static_cast<double>((w > 0.0) - (w < 0.0));
     qdd[i] = tau_J - ws.bias[i];
     // Motor equation (paper eq. (2)): B thetadd = tau - tau_J - tau_F.
-    thetadd[i] = (tau[i] - tau_J - drives_.motor_viscous[i] * w - drives_.motor_coulomb[i] * coulomb) /
-                 drives_.motor_inertia[i];
+    thetadd[i] =
+        (tau[i] - tau_J - drives_.motor_viscous[i] * w - drives_.motor_coulomb[i] * coulomb) /
+        drives_.motor_inertia[i];
   }
   ws.cholesky.solveInPlace(qdd);
 }
@@ -144,8 +151,8 @@ void ElasticSimulator::run(ElasticController& controller, const VectorIn& q0, co
     tau_J_ = drives_.stiffness.cwiseProduct(theta - q);
     controller.command(k, t, q, qd, theta, thetad, tau_J_, tau_);
     if (!tau_.allFinite())
-      throw std::runtime_error("controller: returned a non-finite torque at t = " +
-                               std::to_string(t) + " s");
+      throw std::runtime_error(
+          "controller: returned a non-finite torque at t = " + std::to_string(t) + " s");
     out.q.row(k) = q.transpose();
     out.qd.row(k) = qd.transpose();
     out.theta.row(k) = theta.transpose();
@@ -164,10 +171,10 @@ void ElasticSimulator::run(ElasticController& controller, const VectorIn& q0, co
       x_ += (h / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
     }
     if (!x_.allFinite())
-      throw std::runtime_error("simulate: the state stopped being finite at t = " +
-                               std::to_string(t + dt_) +
-                               " s; the step dt / substeps is too large for the stiffness "
-                               "(h must resolve sqrt(K / B) and sqrt(K / M))");
+      throw std::runtime_error(
+          "simulate: the state stopped being finite at t = " + std::to_string(t + dt_) +
+          " s; the step dt / substeps is too large for the stiffness "
+          "(h must resolve sqrt(K / B) and sqrt(K / M))");
   }
 }
 

@@ -50,9 +50,10 @@ Matrix6 inertia_rate(const Vector6& v, const Matrix6& I) {
 
 }  // namespace
 
-void rnea_time_derivatives(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
-                           const VectorIn& qdd, const VectorIn& qddd, const VectorIn& qdddd,
-                           VectorOut tau, VectorOut tau_dot, VectorOut tau_ddot) {
+void rnea_time_derivatives(const Model& model, Workspace& workspace, const VectorIn& q,
+                           const VectorIn& qd, const VectorIn& qdd, const VectorIn& qddd,
+                           const VectorIn& qdddd, VectorOut tau, VectorOut tau_dot,
+                           VectorOut tau_ddot) {
   using detail::motion_cross;
   detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   const int n = model.n();
@@ -90,8 +91,8 @@ void rnea_time_derivatives(const Model& model, Workspace& workspace, const Vecto
     const Vector6 S3 = motion_cross(j, S) + 2.0 * motion_cross(a, S1) + motion_cross(v, S2);
     s += S * qdddd_i + 3.0 * S1 * qddd_i + 3.0 * S2 * qdd_i + S3 * qd_i;
 
-    const Matrix6 I0 = inertia_matrix(
-        model.body(i - 1).expressed_in_parent(ws.R_world[i], ws.p_world[i]));
+    const Matrix6 I0 =
+        inertia_matrix(model.body(i - 1).expressed_in_parent(ws.R_world[i], ws.p_world[i]));
     const Matrix6 I1 = inertia_rate(v, I0);
     const Matrix6 I2 = inertia_rate(a, I0) + inertia_rate(v, I1);
     const Matrix6 I3 = inertia_rate(j, I0) + 2.0 * inertia_rate(a, I1) + inertia_rate(v, I2);

@@ -36,9 +36,9 @@ from .robot import Robot
 if TYPE_CHECKING:
     from . import models
     from .bounds import DynamicBounds, dynamic_bounds
+    from .cmake import get_cmake_dir, get_include
     from .elastic import ElasticRobot
     from .elastic_identification import DriveIdentification, identify_drives
-    from .cmake import get_cmake_dir, get_include
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
     from .identify import LeastSquaresResult, RankDeficientError, least_squares
@@ -108,7 +108,9 @@ _LAZY = {
 # that it lists every name of _LAZY.
 __all__ = [
     "BaseParameters",
+    "DriveIdentification",
     "DynamicBounds",
+    "ElasticRobot",
     "FourierTrajectory",
     "IdentifiedModel",
     "LeastSquaresResult",
@@ -125,11 +127,13 @@ __all__ = [
     "__version__",
     "base_parameters",
     "dynamic_bounds",
+    "elastic",
     "estimate_payload",
     "excitation",
     "get_cmake_dir",
     "get_include",
     "get_threads",
+    "identify_drives",
     "identify_from_controller",
     "identify_log",
     "io",

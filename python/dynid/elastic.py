@@ -85,7 +85,9 @@ class ElasticRobot:
         (thetad_,) = self._samples(thetad=thetad)
         return self.Fv_m * thetad_ + self.Fs_m * np.sign(thetad_)
 
-    def energy(self, q: ArrayLike, qd: ArrayLike, theta: ArrayLike, thetad: ArrayLike) -> Array | float:
+    def energy(
+        self, q: ArrayLike, qd: ArrayLike, theta: ArrayLike, thetad: ArrayLike
+    ) -> Array | float:
         """Total energy (notes p. 16): link kinetic 1/2 qd^T M(q) qd + motor kinetic
         1/2 thetad^T B thetad + gravity potential U_g(q) + spring 1/2 (theta-q)^T K (theta-q).
         Conserved along free motion (tau = 0) without motor friction. A float, or (T,)."""
@@ -103,7 +105,8 @@ class ElasticRobot:
         qdd = M(q)^-1 (tau_J - c - g) (the rigid body's forward dynamics driven by tau_J, in C++),
         thetadd = B^-1 (tau - tau_J - tau_F(thetad)). One sample (n,) each or T samples (T, n)."""
         q_, qd_, theta_, thetad_, tau_ = self._samples(
-            q=q, qd=qd, theta=theta, thetad=thetad, tau=tau)
+            q=q, qd=qd, theta=theta, thetad=thetad, tau=tau
+        )
         tau_J = self.K * (theta_ - q_)
         qdd = self.link.forward_dynamics(q_, qd_, tau_J)
         thetadd = (tau_ - tau_J - self.Fv_m * thetad_ - self.Fs_m * np.sign(thetad_)) / self.B
@@ -151,8 +154,9 @@ class ElasticRobot:
             if not out:
                 first_name, first_shape = name, a.shape
             elif a.shape != first_shape:
-                raise ValueError(f"{name}: expected shape {first_shape} like {first_name}, "
-                                 f"got {a.shape}")
+                raise ValueError(
+                    f"{name}: expected shape {first_shape} like {first_name}, got {a.shape}"
+                )
             out.append(a)
         return out
 

@@ -49,8 +49,13 @@ class DriveIdentification:
     def elastic_robot(self, robot: Robot) -> ElasticRobot:
         """The identified drives on ``robot``'s links (e.g. the link model identified from
         tau_J); the motor friction estimates are clipped at zero."""
-        return ElasticRobot(robot, self.stiffness, self.motor_inertia,
-                            np.maximum(self.motor_viscous, 0.0), np.maximum(self.motor_coulomb, 0.0))
+        return ElasticRobot(
+            robot,
+            self.stiffness,
+            self.motor_inertia,
+            np.maximum(self.motor_viscous, 0.0),
+            np.maximum(self.motor_coulomb, 0.0),
+        )
 
 
 def identify_stiffness(
@@ -67,8 +72,9 @@ def identify_stiffness(
     K, K_std, o, o_std, rms = (np.zeros(n) for _ in range(5))
     for j in range(n):
         columns = [deflection[:, j]] + ([np.ones(len(q_))] if offset else [])
-        x, std, rms[j] = _fit(np.column_stack(columns), tau_J_[:, j], j, "theta",
-                              "the deflection theta - q")
+        x, std, rms[j] = _fit(
+            np.column_stack(columns), tau_J_[:, j], j, "theta", "the deflection theta - q"
+        )
         K[j], K_std[j] = x[0], std[0]
         if offset:
             o[j], o_std[j] = x[1], std[1]
@@ -88,8 +94,9 @@ def identify_motor_side(
     out = np.zeros((7, n))
     for j in range(n):
         A = np.column_stack([thetadd_[:, j], thetad_[:, j], np.sign(thetad_[:, j])])
-        x, std, out[6, j] = _fit(A, tau_[:, j] - tau_J_[:, j], j, "thetad",
-                                 "motor acceleration, velocity and its sign")
+        x, std, out[6, j] = _fit(
+            A, tau_[:, j] - tau_J_[:, j], j, "thetad", "motor acceleration, velocity and its sign"
+        )
         out[0:6:2, j], out[1:6:2, j] = x, std
     return tuple(out)  # type: ignore[return-value]
 
@@ -114,11 +121,25 @@ def identify_drives(
     B, B_std, Fv, Fv_std, Fs, Fs_std, m_rms = identify_motor_side(thetad, thetadd, tau, tau_J)
     for value in (K, K_std, o, o_std, k_rms, B, B_std, Fv, Fv_std, Fs, Fs_std, m_rms):
         value.setflags(write=False)
-    return DriveIdentification(K, K_std, o, o_std, B, B_std, Fv, Fv_std, Fs, Fs_std, k_rms, m_rms,
-                               samples=int(np.shape(q)[0]))
+    return DriveIdentification(
+        K,
+        K_std,
+        o,
+        o_std,
+        B,
+        B_std,
+        Fv,
+        Fv_std,
+        Fs,
+        Fs_std,
+        k_rms,
+        m_rms,
+        samples=int(np.shape(q)[0]),
+    )
 
 
 # ---- helpers ------------------------------------------------------------------------------------
+
 
 def _logs(**arrays: ArrayLike) -> list[Array]:
     """(T, n) float arrays of one shape, T >= 2; ValueError naming the argument otherwise."""
@@ -140,9 +161,11 @@ def _fit(A: Array, y: Array, joint: int, name: str, what: str) -> tuple[Array, A
     T, p = A.shape
     scale = np.linalg.norm(A, axis=0)
     singular = np.linalg.svd(A / np.where(scale > 0, scale, 1.0), compute_uv=False)
-    if T <= p or np.any(scale == 0) or singular[-1] < 1e-10 * singular[0]:
-        raise ValueError(f"{name}: joint {joint} ({joint + 1} in the notes' numbering): the log "
-                         f"does not separate the columns ({what}); it needs motion on that joint")
+    if p >= T or np.any(scale == 0) or singular[-1] < 1e-10 * singular[0]:
+        raise ValueError(
+            f"{name}: joint {joint} ({joint + 1} in the notes' numbering): the log "
+            f"does not separate the columns ({what}); it needs motion on that joint"
+        )
     x, *_ = np.linalg.lstsq(A, y, rcond=None)
     residual = y - A @ x
     sigma2 = residual @ residual / (T - p)

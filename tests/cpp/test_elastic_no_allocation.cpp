@@ -34,11 +34,12 @@ dynid::Model make_arm() {
   dynid::Matrix4 base = dynid::Matrix4::Identity(), tool = dynid::Matrix4::Identity();
   base(0, 3) = 0.2;
   tool(2, 3) = 0.1;
-  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base, tool);
+  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base,
+                     tool);
   for (int i = 0; i < n; ++i) {
     dynid::Matrix3 inertia = dynid::Matrix3::Identity() * (0.02 + 0.001 * i);
-    model.set_link(i, dynid::RigidBodyParameters::from_physical(2.0 - 0.2 * i,
-                                                                dynid::Vector3(0.01, -0.02, 0.05), inertia));
+    model.set_link(i, dynid::RigidBodyParameters::from_physical(
+                          2.0 - 0.2 * i, dynid::Vector3(0.01, -0.02, 0.05), inertia));
   }
   model.set_rotor_inertia(dynid::VectorX::Constant(n, 0.1));
   model.set_viscous_friction(dynid::VectorX::Constant(n, 0.5));
@@ -66,7 +67,8 @@ int main() {
   const dynid::Model model = make_arm();
   const int n = model.n();
   dynid::Workspace ws(model);
-  dynid::VectorX q(n), qd(n), qdd(n), qddd(n), qdddd(n), tau(n), tau_dot(n), tau_ddot(n), rnea_tau(n);
+  dynid::VectorX q(n), qd(n), qdd(n), qddd(n), qdddd(n), tau(n), tau_dot(n), tau_ddot(n),
+      rnea_tau(n);
 
   counting = true;
   {
@@ -96,7 +98,8 @@ int main() {
     }
     dynid::rnea_time_derivatives(model, ws, q, qd, qdd, qddd, qdddd, tau, tau_dot, tau_ddot);
     dynid::rnea(model, ws, q, qd, qdd, rnea_tau);
-    max_difference_to_rnea = std::fmax(max_difference_to_rnea, (tau - rnea_tau).cwiseAbs().maxCoeff());
+    max_difference_to_rnea =
+        std::fmax(max_difference_to_rnea, (tau - rnea_tau).cwiseAbs().maxCoeff());
     sink += tau_dot[0] + tau_ddot[n - 1];
   }
   counting = false;
@@ -107,15 +110,17 @@ int main() {
   links.set_rotor_inertia(dynid::VectorX::Zero(n));
   links.set_viscous_friction(dynid::VectorX::Zero(n));
   links.set_coulomb_friction(dynid::VectorX::Zero(n));
-  const dynid::ElasticDrives drives{dynid::VectorX::Constant(n, 3000.0), dynid::VectorX::Constant(n, 0.4),
-                                    dynid::VectorX::Constant(n, 1.0), dynid::VectorX::Constant(n, 0.2)};
+  const dynid::ElasticDrives drives{
+      dynid::VectorX::Constant(n, 3000.0), dynid::VectorX::Constant(n, 0.4),
+      dynid::VectorX::Constant(n, 1.0), dynid::VectorX::Constant(n, 0.2)};
   dynid::ElasticSimulator simulator(links, drives, 1e-3, 5, 1e-3);
   dynid::MotorPDController pd(links, drives, dynid::VectorX::Constant(n, 300.0),
                               dynid::VectorX::Constant(n, 30.0), dynid::VectorX::Constant(n, 0.2));
   const int periods = 500;
   dynid::RowMajorMatrixX blocks[6];
   for (auto& b : blocks) b.resize(periods + 1, n);
-  dynid::ElasticSimulationOutput out{blocks[0], blocks[1], blocks[2], blocks[3], blocks[4], blocks[5]};
+  dynid::ElasticSimulationOutput out{blocks[0], blocks[1], blocks[2],
+                                     blocks[3], blocks[4], blocks[5]};
   const dynid::VectorX zero = dynid::VectorX::Zero(n);
   counting = true;
   simulator.run(pd, zero, zero, zero, zero, periods, out);
@@ -142,7 +147,8 @@ int main() {
   ok &= names_argument("tau", [&] { call(q, qd, qdd, qddd, qdddd, short_out, tau_dot, tau_ddot); });
   ok &= names_argument("tau_dot", [&] { call(q, qd, qdd, qddd, qdddd, tau, short_out, tau_ddot); });
   ok &= names_argument("tau_ddot", [&] { call(q, qd, qdd, qddd, qdddd, tau, tau_dot, short_out); });
-  ok &= names_argument("theta0", [&] { simulator.run(pd, zero, zero, short_v, zero, periods, out); });
+  ok &=
+      names_argument("theta0", [&] { simulator.run(pd, zero, zero, short_v, zero, periods, out); });
   ok &= names_argument("periods", [&] { simulator.run(pd, zero, zero, zero, zero, 0, out); });
   dynid::ElasticDrives bad = drives;
   bad.stiffness[0] = 0.0;

@@ -75,16 +75,25 @@ def simulate_elastic(
         raise ValueError(f"elastic: expected a dynid.ElasticRobot, got {type(elastic).__name__}")
     n = elastic.n
     q0 = _vector(q0, "q0", n)
-    theta0 = (q0 + elastic.link.gravity(q0) / elastic.K if theta0 is None
-              else _vector(theta0, "theta0", n))
+    theta0 = (
+        q0 + elastic.link.gravity(q0) / elastic.K
+        if theta0 is None
+        else _vector(theta0, "theta0", n)
+    )
     qd0 = np.zeros(n) if qd0 is None else _vector(qd0, "qd0", n)
     thetad0 = np.zeros(n) if thetad0 is None else _vector(thetad0, "thetad0", n)
     dt = _number(dt, "dt", positive=True)
     duration = _number(duration, "duration", positive=True)
     periods = round(duration / dt)
-    if periods < 1 or periods > 2**31 - 2 or abs(periods * dt - duration) > 1e-9 * max(duration, dt):
-        raise ValueError(f"duration: expected a positive whole number (< 2^31 - 1) of control "
-                         f"periods dt = {dt:g} s, got {duration:g} s")
+    if (
+        periods < 1
+        or periods > 2**31 - 2
+        or abs(periods * dt - duration) > 1e-9 * max(duration, dt)
+    ):
+        raise ValueError(
+            f"duration: expected a positive whole number (< 2^31 - 1) of control "
+            f"periods dt = {dt:g} s, got {duration:g} s"
+        )
     substeps = _integer(substeps, "substeps")
     coulomb_band = _number(coulomb_band, "coulomb_band", positive=False)
     kp = kd = q_d = np.zeros(n)
@@ -98,11 +107,29 @@ def simulate_elastic(
     elif callable(controller):
         kind, function = "callable", controller
     else:
-        raise ValueError(f"controller: expected None, a MotorPD or a callable, got "
-                         f"{type(controller).__name__}")
+        raise ValueError(
+            f"controller: expected None, a MotorPD or a callable, got {type(controller).__name__}"
+        )
     q, qd, theta, thetad, tau, tau_J = _core._simulate_elastic(
-        elastic.link, elastic.K, elastic.B, elastic.Fv_m, elastic.Fs_m, q0, qd0, theta0, thetad0,
-        periods, dt, substeps, coulomb_band, kind, kp, kd, q_d, function)
+        elastic.link,
+        elastic.K,
+        elastic.B,
+        elastic.Fv_m,
+        elastic.Fs_m,
+        q0,
+        qd0,
+        theta0,
+        thetad0,
+        periods,
+        dt,
+        substeps,
+        coulomb_band,
+        kind,
+        kp,
+        kd,
+        q_d,
+        function,
+    )
     t = np.arange(periods + 1) * dt
     return ElasticSimulation(t, q, qd, theta, thetad, tau, tau_J)
 

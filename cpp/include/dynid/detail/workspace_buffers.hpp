@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "dynid/detail/derivative_buffers.hpp"
-#include "dynid/detail/time_derivative_buffers.hpp"
 #include "dynid/detail/joint_transform.hpp"
+#include "dynid/detail/time_derivative_buffers.hpp"
 #include "dynid/rigid_body.hpp"
 #include "dynid/types.hpp"
 
