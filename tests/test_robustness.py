@@ -362,3 +362,31 @@ def test_load_model_reads_builtin_names_and_urdf() -> None:
     assert load_model("ur5") == dynid.models.ur5()
     urdf = "tests/data/urdf/kuka_lwr4.urdf"
     assert load_model(urdf) == dynid.Robot.from_urdf(urdf)
+
+
+def test_recursive_least_squares_pickles_its_whole_state() -> None:
+    """A pickled estimator continues exactly as the original (same updates, bit for bit) and
+    resets to the same initial state; a malformed state is a ValueError naming the field."""
+    import pickle
+
+    rng = np.random.default_rng(7)
+    rls = dynid.RecursiveLeastSquares(4, forgetting=0.98, initial_covariance=50.0)
+    rls.max_variance = 80.0
+    for _ in range(30):
+        rls.update(rng.normal(size=(3, 4)), rng.normal(size=3))
+    again = pickle.loads(pickle.dumps(rls))
+    assert again.forgetting == rls.forgetting and again.max_variance == rls.max_variance
+    for _ in range(5):
+        Y, tau = rng.normal(size=(3, 4)), rng.normal(size=3)
+        rls.update(Y, tau)
+        again.update(Y, tau)
+    assert np.array_equal(again.theta, rls.theta)
+    assert np.array_equal(again.covariance, rls.covariance)
+    rls.reset()
+    again.reset()
+    assert np.array_equal(again.covariance, rls.covariance)
+    state = list(rls.__getstate__())
+    state[5] = np.ones(3)  # D with the wrong length
+    blank = dynid.RecursiveLeastSquares.__new__(dynid.RecursiveLeastSquares)
+    with pytest.raises(ValueError, match="state.D"):
+        blank.__setstate__(tuple(state))

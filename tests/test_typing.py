@@ -94,7 +94,7 @@ def _docstring_parameters(doc: str) -> list[tuple[str, object]]:
     tree = ast.parse(f"def f({inner}): pass").body[0]
     assert isinstance(tree, ast.FunctionDef)
     args = tree.args
-    positional = args.args
+    positional = args.posonlyargs + args.args  # pybind11 marks pickling methods with '/'
     defaults = [inspect.Parameter.empty] * (len(positional) - len(args.defaults)) + [
         ast.literal_eval(d) for d in args.defaults
     ]

@@ -98,6 +98,27 @@ py::array_t<double> copy_of(const VectorX& v) {
   return out;
 }
 
+// Column-major Eigen matrix as a C-ordered (rows, cols) array.
+py::array_t<double> copy_of_matrix(const MatrixX& M) {
+  py::array_t<double> out({M.rows(), M.cols()});
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      out.mutable_data(), M.rows(), M.cols()) = M;
+  return out;
+}
+
+VectorX vector_from(py::handle obj, const char* name) {
+  Array a = as_real_array(obj, name);
+  if (a.ndim() != 1) throw py::value_error(std::string(name) + ": expected a vector");
+  return Eigen::Map<const VectorX>(a.data(), a.shape(0));
+}
+
+MatrixX matrix_from(py::handle obj, const char* name) {
+  Array a = as_real_array(obj, name);
+  if (a.ndim() != 2) throw py::value_error(std::string(name) + ": expected a matrix");
+  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      a.data(), a.shape(0), a.shape(1));
+}
+
 void update(RLS& rls, py::handle Y_obj, py::handle tau_obj) {
   const int p = rls.p();
   Array Y = as_real_array(Y_obj, "Y_k");
@@ -265,6 +286,27 @@ void bind_recursive_least_squares(py::module_& m) {
           "max_variance", &RLS::max_variance, &set_max_variance,
           "Cap on the UD variances with forgetting < 1 (None sets the default, the largest "
           "initial one).")
+      .def(py::pickle(
+          [](const RLS& self) {  // __getstate__: everything that defines the estimator
+            const RLS::State st = self.state();
+            return py::make_tuple(st.forgetting, st.max_variance, st.max_initial_variance,
+                                  copy_of(st.theta), copy_of(st.theta0), copy_of(st.D),
+                                  copy_of(st.D0), copy_of_matrix(st.U), copy_of_matrix(st.U0));
+          },
+          [](const py::tuple& t) {  // __setstate__
+            if (t.size() != 9) throw py::value_error("state: expected 9 entries");
+            RLS::State st;
+            st.forgetting = t[0].cast<double>();
+            st.max_variance = t[1].cast<double>();
+            st.max_initial_variance = t[2].cast<double>();
+            st.theta = vector_from(t[3], "state.theta");
+            st.theta0 = vector_from(t[4], "state.theta0");
+            st.D = vector_from(t[5], "state.D");
+            st.D0 = vector_from(t[6], "state.D0");
+            st.U = matrix_from(t[7], "state.U");
+            st.U0 = matrix_from(t[8], "state.U0");
+            return RLS::from_state(st);
+          }))
       .def("__copy__", [](const RLS& self) { return RLS(self); })
       .def(
           "__deepcopy__", [](const RLS& self, py::handle) { return RLS(self); }, py::arg("memo"))

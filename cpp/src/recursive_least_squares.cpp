@@ -196,4 +196,36 @@ MatrixX RecursiveLeastSquares::covariance() const {
   return P;
 }
 
+RecursiveLeastSquares::State RecursiveLeastSquares::state() const {
+  return State{lambda_, max_variance_, max_initial_variance_, theta_, theta0_, D_, D0_, U_, U0_};
+}
+
+RecursiveLeastSquares RecursiveLeastSquares::from_state(const State& state) {
+  const auto p = state.theta.size();
+  RecursiveLeastSquares rls(static_cast<int>(p), state.forgetting);
+  const auto check = [p](bool ok, const char* name) {
+    if (!ok)
+      throw std::invalid_argument(std::string("state.") + name + ": expected " +
+                                  std::to_string(p) + " entries (p x p for U), finite");
+  };
+  check(state.theta0.size() == p && state.theta0.allFinite(), "theta0");
+  check(state.theta.allFinite(), "theta");
+  check(state.D.size() == p && state.D.allFinite(), "D");
+  check(state.D0.size() == p && state.D0.allFinite(), "D0");
+  check(state.U.rows() == p && state.U.cols() == p && state.U.allFinite(), "U");
+  check(state.U0.rows() == p && state.U0.cols() == p && state.U0.allFinite(), "U0");
+  check(std::isfinite(state.max_variance) && state.max_variance >= 0.0, "max_variance");
+  check(std::isfinite(state.max_initial_variance) && state.max_initial_variance >= 0.0,
+        "max_initial_variance");
+  rls.max_variance_ = state.max_variance;
+  rls.max_initial_variance_ = state.max_initial_variance;
+  rls.theta_ = state.theta;
+  rls.theta0_ = state.theta0;
+  rls.D_ = state.D;
+  rls.D0_ = state.D0;
+  rls.U_ = state.U;
+  rls.U0_ = state.U0;
+  return rls;
+}
+
 }  // namespace dynid

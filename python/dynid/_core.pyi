@@ -277,6 +277,19 @@ class RecursiveLeastSquares:
     """
     def __copy__(self) -> RecursiveLeastSquares: ...
     def __deepcopy__(self, memo: dict[int, typing.Any]) -> RecursiveLeastSquares: ...
+    def __getstate__(
+        self,
+    ) -> tuple[
+        float,
+        float,
+        float,
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+    ]: ...
     def __init__(
         self,
         p: int,
@@ -287,6 +300,7 @@ class RecursiveLeastSquares:
         max_variance: float | None = None,
     ) -> None: ...
     def __repr__(self) -> str: ...
+    def __setstate__(self, arg0: tuple) -> None: ...
     def reset(
         self,
         initial_covariance: float | numpy.typing.ArrayLike | None = None,
@@ -391,7 +405,7 @@ def physical_inconsistency(
 
 def set_threads(threads: int) -> None:
     """
-    Use this many threads (each with its own workspace, GIL released) for batch calls of at least 512 samples per thread. Default 1.
+    Use this many threads (each with its own workspace, GIL released) for batch calls of at least 512 samples per thread. Default 1. Threads the system refuses (memory, thread limit) are skipped: the batch runs on those that start, at least the calling one.
     """
 
 def standard_parameters(

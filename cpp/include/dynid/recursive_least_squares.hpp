@@ -92,6 +92,18 @@ class RecursiveLeastSquares {
   const MatrixX& covariance_factor_U() const { return U_; }
   const VectorX& covariance_factor_D() const { return D_; }
 
+  // The whole state (current and initial estimate and UD factors, forgetting, variance cap), for
+  // saving an estimator and restoring it exactly (Python pickling).
+  struct State {
+    double forgetting = 1.0, max_variance = 0.0, max_initial_variance = 0.0;
+    VectorX theta, theta0, D, D0;
+    MatrixX U, U0;
+  };
+  State state() const;
+  // An estimator in the given state; std::invalid_argument naming the field when sizes disagree,
+  // forgetting is outside (0, 1] or a value is not finite.
+  static RecursiveLeastSquares from_state(const State& state);
+
  private:
   // Bierman's update with one regressor row y (in h_) and its torque, unit measurement variance.
   void update_row(double tau);
