@@ -77,7 +77,8 @@ void bind_elastic(py::module_& m) {
                                              ConstVec(in[4], n), tau, tau_dot, tau_ddot);
                      });
         const auto part = [&](int k) {
-          return s.single ? all[py::int_(k)] : all[py::make_tuple(py::ellipsis(), k, py::slice())];
+          return py::array(s.single ? all[py::int_(k)]
+                                    : all[py::make_tuple(py::ellipsis(), k, py::slice())]);
         };
         return py::make_tuple(part(0), part(1), part(2));
       },
