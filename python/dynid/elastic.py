@@ -25,13 +25,18 @@ per-sample dynamics run in C++ batch calls, the rest is elementwise NumPy.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
 from .robot import Robot
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 
 
 class ElasticRobot:

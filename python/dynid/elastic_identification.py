@@ -16,6 +16,7 @@ residual variance (RSS / (T - p)): valid for white measurement noise on the torq
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -24,7 +25,10 @@ from . import _checks as checks
 from .elastic import ElasticRobot
 from .robot import Robot
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -98,7 +102,7 @@ def identify_motor_side(
             A, tau_[:, j] - tau_J_[:, j], j, "thetad", "motor acceleration, velocity and its sign"
         )
         out[0:6:2, j], out[1:6:2, j] = x, std
-    return tuple(out)  # type: ignore[return-value]
+    return out[0], out[1], out[2], out[3], out[4], out[5], out[6]
 
 
 def identify_drives(
@@ -170,4 +174,8 @@ def _fit(A: Array, y: Array, joint: int, name: str, what: str) -> tuple[Array, A
     residual = y - A @ x
     sigma2 = residual @ residual / (T - p)
     std = np.sqrt(sigma2 * np.diag(np.linalg.inv(A.T @ A)))
-    return x, std, float(np.sqrt(np.mean(residual**2)))
+    return (
+        np.asarray(x, dtype=np.float64),
+        np.asarray(std, dtype=np.float64),
+        float(np.sqrt(np.mean(residual**2))),
+    )

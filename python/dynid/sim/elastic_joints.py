@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,7 +24,10 @@ from .._checks import real_array
 from ..elastic import ElasticRobot
 from .closed_loop import _integer, _number, _vector
 
-Array = NDArray[np.float64]
+if TYPE_CHECKING:
+    from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
+
+Array: TypeAlias = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -130,7 +134,7 @@ def simulate_elastic(
         q_d,
         function,
     )
-    t = np.arange(periods + 1) * dt
+    t = np.asarray(np.arange(periods + 1) * dt, dtype=np.float64)
     return ElasticSimulation(t, q, qd, theta, thetad, tau, tau_J)
 
 
