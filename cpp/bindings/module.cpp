@@ -16,7 +16,8 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
   dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
-  dynid::binding::bind_elastic(m);  // adds rnea_time_derivatives to Model: after bind_model
+  // adds rnea_time_derivatives to Model (after bind_model) and the elastic simulator
+  dynid::binding::bind_elastic(m);
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
   m.def(
