@@ -192,6 +192,68 @@ def batch(
     return result
 
 
+def batch_kernels(
+    robot: Any, pin: Any | None, model: Any, data: Any, Q: Array, Qd: Array, Qdd: Array,
+    runs: int,
+) -> dict[str, Any]:
+    """Batch gravity, mass matrix and (rigid-body) regressor on the T states, time per state
+    [us], against Python loops of Pinocchio's computeGeneralizedGravity, crba and
+    computeJointTorqueRegressor; and batch rnea on every SIMD path this CPU runs
+    (dynid._core._set_batch_isa), checked against the scalar path."""
+    from dynid import _core
+
+    T, n = Q.shape
+    calls: dict[str, tuple[Callable[[], object], Callable[[], object] | None]] = {
+        "gravity": (lambda: robot.gravity(Q), None),
+        "mass_matrix": (lambda: robot.mass_matrix(Q), None),
+        "regressor": (lambda: robot.regressor(Q, Qd, Qdd), None),
+        # the same into a preallocated array: no fresh pages to clear (T x n x 10n doubles)
+        "regressor_out": (lambda: robot.regressor(Q, Qd, Qdd, out=regressor_out), None),
+    }
+    regressor_out = np.empty((T, n, 10 * n))
+    if pin is not None:
+
+        def pin_gravity() -> Array:
+            out = np.empty((T, n))
+            for k, q in enumerate(Q):
+                out[k] = pin.computeGeneralizedGravity(model, data, q)
+            return out
+
+        def pin_crba() -> Array:
+            out = np.empty((T, n, n))
+            for k, q in enumerate(Q):
+                out[k] = pin.crba(model, data, q)
+            return out
+
+        def pin_regressor() -> Array:
+            out = np.empty((T, n, 10 * n))
+            for k, (q, qd, qdd) in enumerate(zip(Q, Qd, Qdd)):
+                out[k] = pin.computeJointTorqueRegressor(model, data, q, qd, qdd)
+            return out
+
+        calls = {name: (calls[name][0], fn) for name, fn in
+                 (("gravity", pin_gravity), ("mass_matrix", pin_crba), ("regressor", pin_regressor),
+                  ("regressor_out", pin_regressor))}
+    result: dict[str, Any] = {"states": T, "isa": _core._batch_isa()}
+    for name, (ours, theirs) in calls.items():
+        stats = time_interleaved([ours] + ([theirs] if theirs else []), runs, T)
+        result[name] = {"dynid": stats[0], "pinocchio": stats[1] if theirs else None}
+    chosen = _core._batch_isa()
+    paths: dict[str, Any] = {}
+    try:
+        _core._set_batch_isa("scalar")
+        reference = robot.rnea(Q, Qd, Qdd)
+        for isa in _core._supported_batch_isas():
+            _core._set_batch_isa(isa)
+            _require_agreement({f"batch rnea {isa}": _worst(robot.rnea(Q, Qd, Qdd), reference)},
+                               f"{isa} lanes vs scalar")
+            paths[isa] = time_interleaved([lambda: robot.rnea(Q, Qd, Qdd)], runs, T)[0]
+    finally:
+        _core._set_batch_isa(chosen)
+    result["rnea_per_path"] = paths
+    return result
+
+
 def batch_threaded(
     robot: Any, Q: Array, Qd: Array, Qdd: Array, runs: int, threads: int
 ) -> dict[str, Any] | None:

@@ -433,7 +433,9 @@ def test_the_documented_example_runs():
 
 # The sources the simulator and its controllers need.
 CORE_SOURCES = ("simulator", "controllers", "rnea", "crba", "gravity", "kinematics", "model",
-                "workspace", "rigid_body", "energy", "argument_checks")
+                "workspace", "rigid_body", "energy", "argument_checks",
+                # the vectorised sin/cos of the joint transforms (2-lane path, no special flags)
+                "batch_dispatch", "batch_lanes_sse2")
 
 
 def find_compiler() -> str | None:

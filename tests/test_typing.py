@@ -107,9 +107,9 @@ def _docstring_parameters(doc: str) -> list[tuple[str, object]]:
 
 
 def test_inspect_signature_shows_the_parameters_of_the_cpp_calls() -> None:
-    assert list(inspect.signature(dynid.Robot.rnea).parameters) == ["self", "q", "qd", "qdd"]
+    assert list(inspect.signature(dynid.Robot.rnea).parameters) == ["self", "q", "qd", "qdd", "out"]
     robot = dynid.models.planar_2r()
-    assert list(inspect.signature(robot.rnea).parameters) == ["q", "qd", "qdd"]
+    assert list(inspect.signature(robot.rnea).parameters) == ["q", "qd", "qdd", "out"]
     signature = inspect.signature(robot.regressor)
     assert signature.parameters["rotor"].default is False
     assert list(inspect.signature(dynid.set_threads).parameters) == ["threads"]

@@ -45,6 +45,10 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     "qddd": ARRAY_LIKE,
     "qdddd": ARRAY_LIKE,
     "tau": ARRAY_LIKE,
+    # batch outputs: a preallocated result array, the regressor's selected columns
+    "out": f"{ARRAY} | None",
+    "columns": f"{ARRAY_LIKE} | None",
+    ("_sincos", "x"): ARRAY_LIKE,
     # model geometry and bodies
     "dh": ARRAY_LIKE,
     "gravity": ARRAY_LIKE,

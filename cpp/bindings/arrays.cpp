@@ -154,6 +154,52 @@ void require_finite_result(const double* data, py::ssize_t n, const char* names)
   }
 }
 
+bool all_finite(const double* data, py::ssize_t n) {
+  // x * 0 is 0 for finite x and NaN otherwise: one branch for the whole block.
+  double check = 0.0;
+  for (py::ssize_t k = 0; k < n; ++k) check += data[k] * 0.0;
+  return check == 0.0;
+}
+
+py::array_t<double> output_array(py::handle out, const std::vector<py::ssize_t>& shape) {
+  if (out.is_none()) return py::array_t<double>(shape);
+  std::string want = "(";
+  for (std::size_t k = 0; k < shape.size(); ++k) want += (k ? ", " : "") + std::to_string(shape[k]);
+  want += shape.size() == 1 ? ",)" : ")";
+  if (!py::isinstance<py::array>(out))
+    throw py::value_error("out: expected a NumPy float64 array of shape " + want + ", got " +
+                          std::string(py::str(py::type::of(out).attr("__name__"))));
+  py::array a = py::reinterpret_borrow<py::array>(out);
+  if (!a.dtype().equal(py::dtype::of<double>()))
+    throw py::value_error("out: expected dtype float64, got " + std::string(py::str(a.dtype())));
+  bool same = a.ndim() == static_cast<py::ssize_t>(shape.size());
+  for (std::size_t k = 0; same && k < shape.size(); ++k) same = a.shape(k) == shape[k];
+  if (!same) throw py::value_error("out: expected shape " + want + ", got " + shape_string(a));
+  if (!(a.flags() & py::array::c_style))
+    throw py::value_error("out: expected a C-contiguous array");
+  if (!a.writeable()) throw py::value_error("out: expected a writable array");
+  return py::reinterpret_borrow<py::array_t<double>>(out);
+}
+
+std::vector<int> parse_columns(py::handle obj, int count) {
+  py::array raw = py::array::ensure(obj);
+  if (!raw) PyErr_Clear();
+  const char kind = raw ? raw.dtype().kind() : '\0';
+  if (!raw || raw.ndim() != 1 || raw.size() == 0 || (kind != 'i' && kind != 'u'))
+    throw py::value_error("columns: expected a non-empty 1-D array of integer column indices, got " +
+                          std::string(py::repr(obj)));
+  const auto values = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(raw);
+  std::vector<int> columns(static_cast<std::size_t>(values.size()));
+  for (py::ssize_t k = 0; k < values.size(); ++k) {
+    const long long c = values.data()[k];
+    if (c < 0 || c >= count)
+      throw py::value_error("columns: expected indices in [0, " + std::to_string(count) + "), got " +
+                            std::to_string(c) + " at position " + std::to_string(k));
+    columns[static_cast<std::size_t>(k)] = static_cast<int>(c);
+  }
+  return columns;
+}
+
 Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_t>& shape) {
   Array a = as_real_array(obj, name);
   bool ok = a.ndim() == static_cast<py::ssize_t>(shape.size());

@@ -41,13 +41,24 @@ Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> 
 
 // Scalars with the type checks of SPEC section 2 (a wrong type is a ValueError naming the
 // argument, not pybind11's TypeError). NumPy scalars and 0-d arrays count as scalars.
-int parse_count(py::handle obj, const char* name);      // an integer >= 1
+int parse_count(py::handle obj, const char* name);     // an integer >= 1
 double parse_number(py::handle obj, const char* name);  // a real number
 bool parse_flag(py::handle obj, const char* name);      // True or False
 
 // Raises ValueError naming `names` when the n values at `data` are not all finite: an overflow
 // from inputs (or parameters) too large for the arithmetic, never returned as NaN.
 void require_finite_result(const double* data, py::ssize_t n, const char* names);
+
+// True when the n values at `data` are all finite.
+bool all_finite(const double* data, py::ssize_t n);
+
+// The result array of a call: a new one of `shape`, or the caller's `out` when given, which must
+// be a writable, C-contiguous float64 array of exactly that shape (ValueError naming `out`).
+py::array_t<double> output_array(py::handle out, const std::vector<py::ssize_t>& shape);
+
+// A 1-D, non-empty array of integer column indices, each in [0, count) (ValueError naming
+// `columns` otherwise).
+std::vector<int> parse_columns(py::handle obj, int count);
 
 // A fixed-size array argument (e.g. gravity (3,), base (4, 4)).
 Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_t>& shape);

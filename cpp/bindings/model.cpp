@@ -2,6 +2,8 @@
 // per-sample dynamics calls (single sample or a batch looped in C++).
 #include "model.hpp"
 
+#include "lanes.hpp"
+
 #include <atomic>
 #include <cctype>
 #include <stdexcept>
@@ -220,87 +222,102 @@ void bind_model(py::module_& m) {
           "Why link i (0-based) is not physically consistent, or '' when it is.")
       .def(
           "rnea",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd) {
+          [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
+            if (use_lanes(self, s))
+              return evaluate_lanes(self, s, {n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                     const double* const* in, double* out, long T) {
+                return k.rnea(bm, in[0], in[1], in[2], out, T);
+              }, out);
             return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutVec tau(out, n);
               rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
-            });
+            }, out);
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("out") = py::none(),
           "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).")
       .def(
           "mass_matrix",
-          [](PyModel& self, py::handle q) {
+          [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
+            if (use_lanes(self, s))
+              return evaluate_lanes(self, s, {n, n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                        const double* const* in, double* out, long T) {
+                return k.mass_matrix(bm, in[0], out, T);
+              }, out);
             return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutMat M = row_major(out, n, n);
               crba(m, ws, ConstVec(in[0], n), M);
-            });
+            }, out);
           },
-          py::arg("q"), "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).")
+          py::arg("q"), py::arg("out") = py::none(), "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).")
       .def(
           "gravity",
-          [](PyModel& self, py::handle q) {
+          [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
+            if (use_lanes(self, s))
+              return evaluate_lanes(self, s, {n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                     const double* const* in, double* out, long T) {
+                return k.gravity(bm, in[0], out, T);
+              }, out);
             return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutVec g(out, n);
               gravity(m, ws, ConstVec(in[0], n), g);
-            });
+            }, out);
           },
-          py::arg("q"), "Gravity torques g(q).")
+          py::arg("q"), py::arg("out") = py::none(), "Gravity torques g(q).")
       .def(
           "coriolis",
-          [](PyModel& self, py::handle q, py::handle qd) {
+          [](PyModel& self, py::handle q, py::handle qd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
             return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutVec c(out, n);
               coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
-            });
+            }, out);
           },
-          py::arg("q"), py::arg("qd"), "Coriolis and centrifugal torques c(q, qd).")
+          py::arg("q"), py::arg("qd"), py::arg("out") = py::none(), "Coriolis and centrifugal torques c(q, qd).")
       .def(
           "coriolis_matrix",
-          [](PyModel& self, py::handle q, py::handle qd) {
+          [](PyModel& self, py::handle q, py::handle qd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
             return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutMat S = row_major(out, n, n);
               coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
-            });
+            }, out);
           },
-          py::arg("q"), py::arg("qd"),
+          py::arg("q"), py::arg("qd"), py::arg("out") = py::none(),
           "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S skew-symmetric.")
       .def(
           "friction",
-          [](PyModel& self, py::handle qd) {
+          [](PyModel& self, py::handle qd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{qd, "qd"}}, n);
             return evaluate(self, s, {n}, [n](const Model& m, Workspace&, const double* const* in, double* out) {
               OutVec tau(out, n);
               friction(m, ConstVec(in[0], n), tau);
-            });
+            }, out);
           },
-          py::arg("qd"), "Joint friction Fv qd + Fs sign(qd).")
+          py::arg("qd"), py::arg("out") = py::none(), "Joint friction Fv qd + Fs sign(qd).")
       .def(
           "forward_dynamics",
-          [](PyModel& self, py::handle q, py::handle qd, py::handle tau) {
+          [](PyModel& self, py::handle q, py::handle qd, py::handle tau, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {tau, "tau"}}, n);
             try {
               return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
                 OutVec qdd(out, n);
                 forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), qdd);
-              });
+              }, out);
             } catch (const std::domain_error& e) {
               throw py::value_error(std::string("params: ") + e.what());
             }
           },
-          py::arg("q"), py::arg("qd"), py::arg("tau"), "Joint accelerations for the torques tau.")
+          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("out") = py::none(), "Joint accelerations for the torques tau.")
       .def(
           "kinetic_energy",
           [](PyModel& self, py::handle q, py::handle qd) {
@@ -323,56 +340,79 @@ void bind_model(py::module_& m) {
           py::arg("q"), "Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).")
       .def(
           "fkine",
-          [](PyModel& self, py::handle q) {
+          [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
             return evaluate(self, s, {4, 4}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutMat T = row_major(out, 4, 4);
               fkine(m, ws, ConstVec(in[0], n), T);
-            });
+            }, out);
           },
-          py::arg("q"), "World pose (4, 4) of the tool: base A_1 ... A_n tool.")
+          py::arg("q"), py::arg("out") = py::none(), "World pose (4, 4) of the tool: base A_1 ... A_n tool.")
       .def(
           "jacobian",
-          [](PyModel& self, py::handle q) {
+          [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
             return evaluate(self, s, {6, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               OutMat J = row_major(out, 6, n);
               jacobian(m, ws, ConstVec(in[0], n), J);
-            });
+            }, out);
           },
-          py::arg("q"), "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
+          py::arg("q"), py::arg("out") = py::none(), "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
       .def(
           "regressor",
           [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle rotor_flag,
-             py::handle friction_flag) {
+             py::handle friction_flag, py::handle columns_arg, py::handle out) {
             const bool rotor = parse_flag(rotor_flag, "rotor");
             const bool friction = parse_flag(friction_flag, "friction");
             const int n = self.model->n();
             const int P = regressor_columns(n, rotor, friction);
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
-            return evaluate(self, s, {n, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              RowMajorMap Y(out, n, P);
+            const std::vector<int> columns =
+                columns_arg.is_none() ? std::vector<int>() : parse_columns(columns_arg, P);
+            const int C = columns.empty() ? P : static_cast<int>(columns.size());
+            if (use_lanes(self, s, detail::kMaxRegressorLaneJoints))
+              return evaluate_lanes(self, s, {n, C}, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                                                         const double* const* in, double* out, long T) {
+                return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
+                                   columns.empty() ? nullptr : columns.data(), C, out, T);
+              }, out);
+            if (columns_arg.is_none())
+              return evaluate(self, s, {n, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                RowMajorMap Y(out, n, P);
+                regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor, friction, Y);
+              }, out);
+            // Only the selected columns (e.g. the base parameters'): each sample's full regressor
+            // goes to a per-thread buffer in cache and the columns are copied out of it.
+            return evaluate(self, s, {n, C}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+              thread_local std::vector<double> full;
+              full.resize(static_cast<std::size_t>(n) * P);
+              RowMajorMap Y(full.data(), n, P);
               regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor, friction, Y);
-            });
+              for (int i = 0; i < n; ++i)
+                for (int k = 0; k < C; ++k) out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
+            }, out);
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false, py::arg("friction") = false,
-          "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea.")
+          py::arg("columns") = py::none(), py::arg("out") = py::none(),
+          "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; with "
+          "columns (indices into the P columns, e.g. base_parameters(...).independent) only those, "
+          "(n, len(columns)); out: a preallocated float64 result array of the exact shape.")
       .def(
           "gravity_regressor",
-          [](PyModel& self, py::handle q) {
+          [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
             return evaluate(self, s, {n, 10 * n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
               RowMajorMap Y(out, n, 10 * n);
               gravity_regressor(m, ws, ConstVec(in[0], n), Y);
-            });
+            }, out);
           },
-          py::arg("q"), "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
+          py::arg("q"), py::arg("out") = py::none(), "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
       .def(
           "inertia_regressor",
-          [](PyModel& self, py::handle q, py::handle rotor_flag) {
+          [](PyModel& self, py::handle q, py::handle rotor_flag, py::handle out) {
             const bool rotor = parse_flag(rotor_flag, "rotor");
             const int n = self.model->n();
             const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
@@ -380,9 +420,9 @@ void bind_model(py::module_& m) {
             return evaluate(self, s, {rows, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
               RowMajorMap Y(out, rows, P);
               inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
-            });
+            }, out);
           },
-          py::arg("q"), py::arg("rotor") = false,
+          py::arg("q"), py::arg("rotor") = false, py::arg("out") = py::none(),
           "Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] "
           "(links only, or with the rotor columns the full M) (paper eq. (18)).");
 }

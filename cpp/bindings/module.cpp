@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "elastic.hpp"
+#include "lanes.hpp"
+#include "fast_calls.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 #include "simulator.hpp"
@@ -18,6 +20,7 @@ PYBIND11_MODULE(_core, m) {
   dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
   // adds rnea_time_derivatives to Model (after bind_model) and the elastic simulator
   dynid::binding::bind_elastic(m);
+  dynid::binding::bind_lanes(m);
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
   m.def(
@@ -48,5 +51,7 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("mass"), py::arg("inertia_com"),
       "Why a body of this mass and inertia about its centre of mass cannot exist ('' if it can).");
-  dynid::binding::add_text_signatures(m);  // last: after every function is defined
+  dynid::binding::add_text_signatures(m);  // after every function is defined
+  // Last: the fast methods take the pybind11 methods' docstrings with their text signatures.
+  dynid::binding::bind_fast_calls(m);
 }

@@ -65,9 +65,11 @@ void composite_rigid_body(const Model& model, WorkspaceBuffers& ws, MatrixOut B)
   for (int i = 1; i <= n; ++i) ws.composite[i] = from_body(model.body(i - 1));
   for (int i = n; i >= 2; --i) add_to_parent(ws.X[i], ws.composite[i], ws.composite[i - 1]);
 
+  // Column i of B starts as the wrench of composite i for a unit acceleration of joint i ...
   for (int i = 1; i <= n; ++i) {
     const Composite& C = ws.composite[i];
-    Vector3 f, mu;  // wrench about the origin of J_i for a unit acceleration along z
+    Vector3& f = ws.f[i];
+    Vector3& mu = ws.mu[i];  // about the origin of J_i
     if (model.joint(i - 1).revolute) {
       mu = Vector3(C.I[2], C.I[4], C.I[5]);  // I e_z
       f = Vector3(-C.h.y(), C.h.x(), 0.0);   // z x h
@@ -76,11 +78,30 @@ void composite_rigid_body(const Model& model, WorkspaceBuffers& ws, MatrixOut B)
       f = Vector3(0.0, 0.0, C.m);
     }
     B(i - 1, i - 1) = model.joint(i - 1).revolute ? mu.z() : f.z();
-    for (int j = i - 1; j >= 1; --j) {
-      const JointTransform& X = ws.X[j + 1];
-      f = X.rotate_to_parent(f);
-      mu = X.rotate_to_parent(mu) + X.p.cross(f);
-      const double bji = model.joint(j - 1).revolute ? mu.z() : f.z();
+  }
+  // ... and is carried inwards frame by frame. Every column that has reached J_{j+1} crosses
+  // X[j+1] in the same sweep: the columns' chains are independent, so interleaving them keeps
+  // the floating-point units busy instead of waiting on one chain's latency.
+  // Written out in scalars (JointTransform::rotate_to_parent, then mu += p x f): GCC's
+  // vectorisation of the Eigen form packed pairs through the stack and stalled on store
+  // forwarding, which cost more than the arithmetic.
+  for (int j = n - 1; j >= 1; --j) {
+    const JointTransform& X = ws.X[j + 1];
+    const double ct = X.ct, st = X.st, ca = X.ca, sa = X.sa;
+    const double px = X.p.x(), py = X.p.y(), pz = X.p.z();
+    const bool revolute = model.joint(j - 1).revolute;
+    for (int i = j + 1; i <= n; ++i) {
+      double* f = ws.f[i].data();
+      double* mu = ws.mu[i].data();
+      const double f1 = st * f[0] + ct * f[1];
+      const double F0 = ct * f[0] - st * f[1], F1 = ca * f1 - sa * f[2], F2 = sa * f1 + ca * f[2];
+      const double m1 = st * mu[0] + ct * mu[1];
+      const double M0 = ct * mu[0] - st * mu[1] + (py * F2 - pz * F1);
+      const double M1 = ca * m1 - sa * mu[2] + (pz * F0 - px * F2);
+      const double M2 = sa * m1 + ca * mu[2] + (px * F1 - py * F0);
+      f[0] = F0, f[1] = F1, f[2] = F2;
+      mu[0] = M0, mu[1] = M1, mu[2] = M2;
+      const double bji = revolute ? M2 : F2;
       B(j - 1, i - 1) = bji;
       B(i - 1, j - 1) = bji;
     }

@@ -1,19 +1,31 @@
 #include "dynid/kinematics.hpp"
 
+#include <algorithm>
+
 #include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/batch.hpp"
 #include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
 namespace detail {
 
 void update_joint_transforms(const Model& model, WorkspaceBuffers& ws, const VectorIn& q) {
-  for (int i = 1; i <= ws.n; ++i) {
-    const JointGeometry& j = model.joint(i - 1);
-    const double qi = q[i - 1];
-    if (j.revolute)
-      ws.X[i].set(j.cos_alpha, j.sin_alpha, j.a, qi + j.theta, j.d);
-    else
-      ws.X[i].set(j.cos_alpha, j.sin_alpha, j.a, j.theta, qi + j.d);
+  // All joint angles' sin and cos in one vectorised call (detail::sincos_many: SIMD lanes, a few
+  // ulp) instead of one libm call per joint, which costs as much as the rest of a small kernel.
+  constexpr int kChunk = 16;
+  double angle[kChunk], s[kChunk], c[kChunk];
+  for (int first = 1; first <= ws.n; first += kChunk) {
+    const int last = std::min(ws.n, first + kChunk - 1);
+    for (int i = first; i <= last; ++i) {
+      const JointGeometry& j = model.joint(i - 1);
+      angle[i - first] = j.revolute ? q[i - 1] + j.theta : j.theta;
+    }
+    sincos_many(angle, s, c, last - first + 1);
+    for (int i = first; i <= last; ++i) {
+      const JointGeometry& j = model.joint(i - 1);
+      const double d = j.revolute ? j.d : q[i - 1] + j.d;
+      ws.X[i].set(j.cos_alpha, j.sin_alpha, j.a, c[i - first], s[i - first], d);
+    }
   }
 }
 

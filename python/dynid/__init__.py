@@ -51,6 +51,7 @@ if TYPE_CHECKING:
     from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
     from .sim import VirtualController, simulate
+    from .streaming import LeastSquaresAccumulator, least_squares_streaming
     from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 #: Public name -> the module that defines it (imported on first access).
@@ -71,6 +72,8 @@ _LAZY = {
     "LeastSquaresResult": ".identify",
     "RankDeficientError": ".identify",
     "least_squares": ".identify",
+    "LeastSquaresAccumulator": ".streaming",
+    "least_squares_streaming": ".streaming",
     "Log": ".io.log_files",
     "load_log": ".io.log_files",
     "save_log": ".io.log_files",
@@ -113,6 +116,7 @@ __all__ = [
     "ElasticRobot",
     "FourierTrajectory",
     "IdentifiedModel",
+    "LeastSquaresAccumulator",
     "LeastSquaresResult",
     "Log",
     "LogIdentification",
@@ -138,6 +142,7 @@ __all__ = [
     "identify_log",
     "io",
     "least_squares",
+    "least_squares_streaming",
     "load_log",
     "load_model",
     "load_result",

@@ -23,6 +23,104 @@ __all__: list[str] = [
 ]
 
 class Model:
+    @staticmethod
+    def _coriolis_full(*args, **kwargs):
+        """
+        coriolis(self: dynid._core.Model, q: object, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Coriolis and centrifugal torques c(q, qd).
+        """
+    @staticmethod
+    def _coriolis_matrix_full(*args, **kwargs):
+        """
+        coriolis_matrix(self: dynid._core.Model, q: object, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S skew-symmetric.
+        """
+    @staticmethod
+    def _fkine_full(*args, **kwargs):
+        """
+        fkine(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        World pose (4, 4) of the tool: base A_1 ... A_n tool.
+        """
+    @staticmethod
+    def _forward_dynamics_full(*args, **kwargs):
+        """
+        forward_dynamics(self: dynid._core.Model, q: object, qd: object, tau: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Joint accelerations for the torques tau.
+        """
+    @staticmethod
+    def _friction_full(*args, **kwargs):
+        """
+        friction(self: dynid._core.Model, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Joint friction Fv qd + Fs sign(qd).
+        """
+    @staticmethod
+    def _gravity_full(*args, **kwargs):
+        """
+        gravity(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Gravity torques g(q).
+        """
+    @staticmethod
+    def _gravity_regressor_full(*args, **kwargs):
+        """
+        gravity_regressor(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).
+        """
+    @staticmethod
+    def _inertia_regressor_full(*args, **kwargs):
+        """
+        inertia_regressor(self: dynid._core.Model, q: object, rotor: object = False, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] (links only, or with the rotor columns the full M) (paper eq. (18)).
+        """
+    @staticmethod
+    def _jacobian_full(*args, **kwargs):
+        """
+        jacobian(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].
+        """
+    @staticmethod
+    def _kinetic_energy_full(*args, **kwargs):
+        """
+        kinetic_energy(self: dynid._core.Model, q: object, qd: object) -> object
+
+        Kinetic energy 1/2 qd^T M(q) qd (rotors included).
+        """
+    @staticmethod
+    def _mass_matrix_full(*args, **kwargs):
+        """
+        mass_matrix(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).
+        """
+    @staticmethod
+    def _potential_energy_full(*args, **kwargs):
+        """
+        potential_energy(self: dynid._core.Model, q: object) -> object
+
+        Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).
+        """
+    @staticmethod
+    def _regressor_full(*args, **kwargs):
+        """
+        regressor(self: dynid._core.Model, q: object, qd: object, qdd: object, rotor: object = False, friction: object = False, columns: object = None, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; with columns (indices into the P columns, e.g. base_parameters(...).independent) only those, (n, len(columns)); out: a preallocated float64 result array of the exact shape.
+        """
+    @staticmethod
+    def _rnea_full(*args, **kwargs):
+        """
+        rnea(self: dynid._core.Model, q: object, qd: object, qdd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
+
+        Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).
+        """
     def __init__(
         self,
         dh: numpy.typing.ArrayLike,
@@ -44,46 +142,69 @@ class Model:
         inertia_com: numpy.typing.ArrayLike,
     ) -> None: ...
     def coriolis(
-        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike
+        self,
+        q: numpy.typing.ArrayLike,
+        qd: numpy.typing.ArrayLike,
+        out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Coriolis and centrifugal torques c(q, qd).
         """
     def coriolis_matrix(
-        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike
+        self,
+        q: numpy.typing.ArrayLike,
+        qd: numpy.typing.ArrayLike,
+        out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S skew-symmetric.
         """
-    def fkine(self, q: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    def fkine(
+        self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
+    ) -> numpy.typing.NDArray[numpy.float64]:
         """
         World pose (4, 4) of the tool: base A_1 ... A_n tool.
         """
     def forward_dynamics(
-        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tau: numpy.typing.ArrayLike
+        self,
+        q: numpy.typing.ArrayLike,
+        qd: numpy.typing.ArrayLike,
+        tau: numpy.typing.ArrayLike,
+        out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Joint accelerations for the torques tau.
         """
-    def friction(self, qd: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    def friction(
+        self, qd: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
+    ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Joint friction Fv qd + Fs sign(qd).
         """
-    def gravity(self, q: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    def gravity(
+        self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
+    ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Gravity torques g(q).
         """
-    def gravity_regressor(self, q: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    def gravity_regressor(
+        self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
+    ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).
         """
     def inertia_regressor(
-        self, q: numpy.typing.ArrayLike, rotor: bool = False
+        self,
+        q: numpy.typing.ArrayLike,
+        rotor: bool = False,
+        out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] (links only, or with the rotor columns the full M) (paper eq. (18)).
         """
-    def jacobian(self, q: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    def jacobian(
+        self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
+    ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].
         """
@@ -99,7 +220,9 @@ class Model:
         """
         Kinetic energy 1/2 qd^T M(q) qd (rotors included).
         """
-    def mass_matrix(self, q: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    def mass_matrix(
+        self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
+    ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).
         """
@@ -116,12 +239,18 @@ class Model:
         qdd: numpy.typing.ArrayLike,
         rotor: bool = False,
         friction: bool = False,
+        columns: numpy.typing.ArrayLike | None = None,
+        out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
-        Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea.
+        Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; with columns (indices into the P columns, e.g. base_parameters(...).independent) only those, (n, len(columns)); out: a preallocated float64 result array of the exact shape.
         """
     def rnea(
-        self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike
+        self,
+        q: numpy.typing.ArrayLike,
+        qd: numpy.typing.ArrayLike,
+        qdd: numpy.typing.ArrayLike,
+        out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
         Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).
@@ -131,21 +260,6 @@ class Model:
     ) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
         """
         Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, n, n) each for T samples (Carpentier & Mansard 2018); dtau_dqd includes diag(Fv), dtau/dqdd is mass_matrix(q). Both are views into one (2, n, n) or (T, 2, n, n) array.
-        """
-    def rnea_time_derivatives(
-        self,
-        q: numpy.typing.ArrayLike,
-        qd: numpy.typing.ArrayLike,
-        qdd: numpy.typing.ArrayLike,
-        qddd: numpy.typing.ArrayLike,
-        qdddd: numpy.typing.ArrayLike,
-    ) -> tuple[
-        numpy.typing.NDArray[numpy.float64],
-        numpy.typing.NDArray[numpy.float64],
-        numpy.typing.NDArray[numpy.float64],
-    ]:
-        """
-        Inverse dynamics and its exact first and second time derivatives (tau, tau_dot, tau_ddot) along a motion with joint derivatives qd, qdd, qddd (jerk) and qdddd (snap): (n,) each, or (T, n) each for T samples (views into one (3, n) or (T, 3, n) array). tau equals rnea(q, qd, qdd) (links, gravity and drive terms); tau_dot = dtau/dq qd + dtau/dqd qdd + M qddd, tau_ddot its time derivative. Drive terms are included (Ia qddd + Fv qdd and Ia qdddd + Fv qddd); Coulomb friction is flat away from qd = 0. Use robot.rigid_body() for the links alone (the link side of ElasticRobot).
         """
     @property
     def Fs(self) -> numpy.typing.NDArray[numpy.float64]:
@@ -364,9 +478,19 @@ class RecursiveLeastSquares:
         Current estimate (p,), a copy.
         """
 
+def _batch_isa() -> str:
+    """
+    The path batch calls of rnea, gravity and mass_matrix run on: 'scalar' (the per-sample kernels), 'sse2', 'avx2' or 'avx512' (SIMD lanes across samples).
+    """
+
 def _last_batch_threads() -> int:
     """
     Threads the last batch call ran on.
+    """
+
+def _set_batch_isa(isa: str) -> None:
+    """
+    Force a batch path (for tests); also DYNID_BATCH_ISA at import. ValueError when the CPU cannot run it.
     """
 
 def _simulate(
@@ -406,46 +530,16 @@ def _simulate(
     Closed-loop simulation (use dynid.sim.simulate): returns q, qd, qdd, tau and the measured q (or None), each (periods + 1, n).
     """
 
-def _simulate_elastic(
-    links: Model,
-    stiffness: numpy.typing.ArrayLike,
-    motor_inertia: numpy.typing.ArrayLike,
-    motor_viscous: numpy.typing.ArrayLike,
-    motor_coulomb: numpy.typing.ArrayLike,
-    q0: numpy.typing.ArrayLike,
-    qd0: numpy.typing.ArrayLike,
-    theta0: numpy.typing.ArrayLike,
-    thetad0: numpy.typing.ArrayLike,
-    periods: typing.SupportsInt | typing.SupportsIndex,
-    dt: typing.SupportsFloat | typing.SupportsIndex,
-    substeps: typing.SupportsInt | typing.SupportsIndex,
-    coulomb_band: typing.SupportsFloat | typing.SupportsIndex,
-    kind: str,
-    kp: numpy.typing.ArrayLike,
-    kd: numpy.typing.ArrayLike,
-    q_d: numpy.typing.ArrayLike,
-    function: typing.Callable[
-        [
-            float,
-            numpy.typing.NDArray[numpy.float64],
-            numpy.typing.NDArray[numpy.float64],
-            numpy.typing.NDArray[numpy.float64],
-            numpy.typing.NDArray[numpy.float64],
-            numpy.typing.NDArray[numpy.float64],
-        ],
-        numpy.typing.ArrayLike,
-    ]
-    | None,
-) -> tuple[
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-]:
+def _sincos(
+    x: numpy.typing.ArrayLike,
+) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
-    Closed-loop simulation of an elastic-joint robot (use dynid.sim.simulate_elastic): returns q, qd, theta, thetad, tau, tau_J, each (periods + 1, n).
+    sin and cos of the flattened x by the vectorised sincos the kernels use (tests).
+    """
+
+def _supported_batch_isas() -> list:
+    """
+    The batch paths this CPU and build can run.
     """
 
 def get_threads() -> int:

@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from . import _checks as checks
 from ._equality import ValueEquality
+from ._threads import blas_single_threaded
 from .robot import Robot
 
 #: A column is independent when, after scaling every column to unit norm, the part of it outside
@@ -113,6 +114,7 @@ def stacked_regressor(
     return Y.reshape(-1, Y.shape[-1])
 
 
+@blas_single_threaded  # small dense work: threads only wait for cores (_threads.py)
 def _compute(robot: Robot, kind: str, rotor: bool, friction: bool) -> BaseParameters:
     n = robot.n
     rows_per_sample = n * (n + 1) // 2 if kind == "inertia" else n

@@ -26,6 +26,7 @@ import numpy as np
 
 from . import models, plots
 from ._checks import count
+from ._threads import blas_single_threaded
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
 from .robot import Robot
 from .signal import differentiate, lowpass
@@ -74,6 +75,7 @@ def controller_model() -> Robot:
     return robot
 
 
+@blas_single_threaded  # small dense work throughout (_threads.py)
 def run_demo(
     output: str | Path = "dynid-demo",
     train: int = 1000,

@@ -7,8 +7,9 @@ identification" (p. 28): stack "all time evaluations sequenced by the rows" of t
 (all samples of joint 1, then joint 2, ...), and check full column rank numerically.
 
 The pseudoinverse is never formed from the normal equations (Y^T Y)^-1 Y^T, which square the
-condition number: the stacked matrix A is factored A = Q R, and the small triangular factor, its
-columns scaled to unit norm, by the SVD R D^-1 = U S V^T; the one factorisation
+condition number: [A | b] is factored by Householder QR, keeping only the triangular factor R
+(per joint, chunk by chunk: _qr.py, so neither Q nor the stacked matrix is ever formed), and R's
+first p columns, scaled to unit norm, by the SVD R D^-1 = U S V^T; the one factorisation
 A D^-1 = (Q U) S V^T serves the rank test, the solution and the covariance alike.
 """
 
@@ -19,12 +20,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
 from ._checks import real_array
 from ._equality import ValueEquality
+from ._qr import GroupedTriangularFactors, solve_triangular_system
+from ._threads import blas_single_threaded
 
 METHODS = ("ols", "wls")
 ON_RANK_DEFICIENT = ("raise", "warn")
@@ -109,6 +111,7 @@ def stack_by_joint(
     return np.ascontiguousarray(A), np.ascontiguousarray(b), group
 
 
+@blas_single_threaded  # QR blocks of ~1000 x p: faster on one thread (_threads.py)
 def least_squares(
     Y: ArrayLike,
     tau: ArrayLike,
@@ -160,14 +163,46 @@ def least_squares(
     solution are computed, is at most sqrt(p) times the smallest achievable by any column scaling
     (van der Sluis), and can be much smaller than this one.
     """
+    method, on_rank_deficient = _check_options(method, on_rank_deficient, rank_tolerance)
+    Y, tau = _samples(Y, tau)
+    excluded = tuple(sorted(_excluded(exclude_joints, Y.shape[1])))
+    T, n, p = Y.shape
+    factors = GroupedTriangularFactors(n, p, tuple(j for j in range(n) if j not in excluded))
+    for begin in range(0, T, CHUNK_SAMPLES):  # bounded scratch memory, whatever T
+        factors.add(Y[begin : begin + CHUNK_SAMPLES], tau[begin : begin + CHUNK_SAMPLES])
+    return solve_factors(
+        factors,
+        method=method,
+        names=names,
+        on_rank_deficient=on_rank_deficient,
+        rank_tolerance=rank_tolerance,
+        excluded=excluded,
+    )
+
+
+#: Samples per QR update: large enough for blocked Householder QR, small enough for the cache.
+CHUNK_SAMPLES = 4096
+
+
+def _check_options(method: str, on_rank_deficient: str, rank_tolerance: float) -> tuple[str, str]:
     method = _choice(method, METHODS, "method")
     on_rank_deficient = _choice(on_rank_deficient, ON_RANK_DEFICIENT, "on_rank_deficient")
     if not (isinstance(rank_tolerance, (int, float)) and 0.0 < rank_tolerance < 1.0):
         raise ValueError(f"rank_tolerance: expected a number in (0, 1), got {rank_tolerance!r}")
-    Y, tau = _samples(Y, tau)
-    excluded = tuple(sorted(_excluded(exclude_joints, Y.shape[1])))
-    A, b, group = stack_by_joint(Y, tau, excluded)
-    rows, p = A.shape
+    return method, on_rank_deficient
+
+
+def solve_factors(
+    factors: GroupedTriangularFactors,
+    *,
+    method: str,
+    names: Sequence[str] | None,
+    on_rank_deficient: str,
+    rank_tolerance: float,
+    excluded: tuple[int, ...],
+) -> LeastSquaresResult:
+    """The OLS or WLS estimate of :func:`least_squares` from accumulated triangular factors."""
+    rows, p = factors.rows, factors.p
     if names is not None:
         names = checks.names(names, "names", p)
     if rows < p:
@@ -175,62 +210,62 @@ def least_squares(
             f"Y: {rows} stacked rows for {p} parameters; at least {p} rows are needed "
             f"(the lecture asks for N >> p): use more samples"
         )
-    joints, member = np.unique(group, return_inverse=True)
-    counts = np.bincount(member)
-    # Solve in units where max |A| and max |b| are in [0.5, 1): squares and norms of values near
-    # the float64 limits (~1e154 and up) would overflow, tiny ones underflow. Powers of two
-    # scale exactly, and everything is scaled back at the end.
-    a_exp, b_exp = _exponent(A), _exponent(b)
-    sizes = f"max |Y| {np.abs(A).max():.3g}, max |tau| {np.abs(b).max():.3g}"
-    A, b = np.ldexp(A, -a_exp), np.ldexp(b, -b_exp)
+    joints = np.array(factors.joints, dtype=np.int64)
+    counts = np.full(joints.size, factors.samples)
+    # Factors are in units where max |A| and max |b| are in [0.5, 1) (_qr.py): squares and norms
+    # of values near the float64 limits would overflow, tiny ones underflow. Everything is
+    # scaled back at the end.
+    a_exp, b_exp = factors.a_exp or 0, factors.b_exp or 0
+    sizes = f"max |Y| {factors.max_a:.3g}, max |tau| {factors.max_b:.3g}"
 
     def check_rank(rank: int, null: NDArray[np.float64], previous: int) -> None:
         if rank < min(p, previous):  # warn once per drop (WLS re-checks its weighted matrix)
             message = _rank_message(rank, p, null, names)
             if on_rank_deficient == "raise":
                 raise RankDeficientError(message)
-            warnings.warn(message, RuntimeWarning, stacklevel=3)
+            warnings.warn(message, RuntimeWarning, stacklevel=4)
 
     # OLS (p. 27): theta = Y^# u through QR + SVD, never the normal equations.
-    theta, unit_cov, rank, null, cond = _svd_solve(A, b, rank_tolerance)
+    theta, unit_cov, rank, null, cond = solve_triangular_system(
+        factors.combined(), p, rank_tolerance
+    )
     check_rank(rank, null, p)
-    residual = b - A @ theta
+    squares = factors.residual_squares(theta)
     dof = rows - rank
     if dof == 0:
         warnings.warn(
             f"Y: {rows} rows for rank {rank} leave no degrees of freedom to estimate the noise; "
             "std set to inf (use more samples)",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
         variance = np.full(joints.size, np.inf)
     else:  # sigma_j^2 = ||r_j||^2 / (N_j - p N_j / N)
-        variance = np.bincount(member, weights=residual**2) / (counts * dof / rows)
+        variance = squares / (counts * dof / rows)
 
     if dof == 0:
         covariance = np.full((p, p), np.inf)
     elif method == "ols":
-        covariance = (residual @ residual / dof) * unit_cov
+        covariance = (squares.sum() / dof) * unit_cov
     else:  # WLS (p. 27, weighted pseudoinverse): rows of joint j divided by sigma_j
         largest = variance.max()
         floored = np.maximum(variance, VARIANCE_FLOOR * largest)
         if largest == 0:  # every joint fitted exactly: equal weights
             floored = np.ones_like(variance)
-        weight = 1.0 / np.sqrt(floored)[member]
         ols_rank = rank
-        theta, unit_cov, rank, null, cond = _svd_solve(
-            A * weight[:, None], b * weight, rank_tolerance
+        theta, unit_cov, rank, null, cond = solve_triangular_system(
+            factors.combined(1.0 / np.sqrt(floored)), p, rank_tolerance
         )
         check_rank(rank, null, ols_rank)
         covariance = unit_cov if largest > 0 else np.zeros((p, p))
-        residual = b - A @ theta
+        squares = factors.residual_squares(theta)
 
     if rank < p:  # parameters entering a null direction have no finite variance
         free = np.abs(null).max(axis=1) > IDENTIFIABLE_TOLERANCE
         covariance = covariance.copy()
         covariance[free, :] = np.inf
         covariance[:, free] = np.inf
-    residual_rms = np.sqrt(np.bincount(member, weights=residual**2) / counts)
+    residual_rms = np.sqrt(squares / counts)
     # Back to the units given: theta scales by 2^(b_exp - a_exp), the variances by its square.
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))  # before its square can underflow
     theta = _unscale(theta, b_exp - a_exp, "Y, tau", "the estimate theta ~ tau / Y", sizes)
@@ -254,38 +289,6 @@ def least_squares(
         excluded=excluded,
         joints=tuple(int(j) for j in joints),
     )
-
-
-def _svd_solve(
-    A: NDArray[np.float64], b: NDArray[np.float64], tolerance: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64], int, NDArray[np.float64], float]:
-    """theta, (A^T A)^+, rank, null-space basis (scaled coordinates) and cond(A).
-
-    A = Q R (economic QR of the tall stack), then the small SVD R D^-1 = U S V^T with D the
-    column norms, so that A D^-1 = (Q U) S V^T. Over the r singular values above
-    tolerance * s_max: theta = D^-1 V_r S_r^-1 U_r^T Q^T b, (A^T A)^+ = D^-1 V_r S_r^-2 V_r^T D^-1.
-    """
-    # Column norms computed on columns divided by their largest entry: no overflow or underflow
-    # of the squares whatever the magnitudes.
-    peak = np.abs(A).max(axis=0)
-    peak[peak == 0] = 1.0
-    scale = peak * np.linalg.norm(A / peak, axis=0)
-    scale[scale == 0] = 1.0  # an all-zero column keeps a zero singular value
-    Q, R = scipy.linalg.qr(A, mode="economic")
-    U, s, Vt = scipy.linalg.svd(R / scale, lapack_driver="gesvd")
-    rank = int(np.count_nonzero(s > tolerance * s[0])) if s[0] > 0 else 0
-    V = Vt[:rank].T / s[:rank]  # V_r S_r^-1
-    theta = (V @ (U[:, :rank].T @ (Q.T @ b))) / scale
-    unit_cov = (V @ V.T) / np.outer(scale, scale)
-    unscaled = scipy.linalg.svdvals(R)  # the singular values of A
-    cond = float(unscaled[0] / unscaled[-1]) if unscaled[-1] > 0 else np.inf
-    return theta, unit_cov, rank, Vt[rank:].T, cond
-
-
-def _exponent(x: NDArray[np.float64]) -> int:
-    """The e with max |x| / 2^e in [0.5, 1) (0 for an all-zero x)."""
-    largest = float(np.abs(x).max()) if x.size else 0.0
-    return int(np.frexp(largest)[1]) if largest > 0 else 0
 
 
 def _unscale(

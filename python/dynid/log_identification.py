@@ -13,7 +13,8 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
    position torque ks_j sin q_j + kc_j cos q_j per joint (``dynid.position_torque``: a
    once-per-turn torque of the joint's sensor, gear or cables; only on the joints where it is
    structurally identifiable);
-4. the stacked system is solved by OLS or WLS (``dynid.identify.least_squares``);
+4. the stacked system is solved by OLS or WLS (``dynid.streaming``: the regressor chunk by
+   chunk into triangular factors, the solver of ``dynid.identify.least_squares``);
 5. with ``physical=True``, the standard parameters are then estimated by the physically
    consistent semidefinite programme (``dynid.physical.physical_least_squares``: same columns,
    same WLS weights, the offsets and position torques unconstrained, optionally a prior model),
@@ -38,13 +39,14 @@ from numpy.typing import NDArray
 
 from ._equality import ValueEquality
 from .base_parameters import base_parameters
-from .identify import VARIANCE_FLOOR, least_squares
+from .identify import VARIANCE_FLOOR
 from .io.log_files import Log
 from .io.model_files import load_model, model_from_dict, model_to_dict
 from .io.preparation import prepare_log
 from .physical import physical_least_squares
 from .position_torque import position_columns, position_names, position_torque_joints
 from .robot import Robot
+from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
 
 PathLike = Union[str, Path]
@@ -57,6 +59,9 @@ OFFSET_NAME = "off"
 #: the relative training residual of the physical fit rises by less than 10 % over the prior-free
 #: fit; it pins the masses near the prior's while leaving the excited directions to the data.
 DEFAULT_PRIOR_WEIGHT = 1e-5
+
+#: Samples per regressor chunk folded into the least-squares factors.
+STREAM_CHUNK = 8192
 
 #: The options of dynid.io.prepare_log that ``preparation`` may hold.
 PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "outlier_k",
@@ -134,15 +139,19 @@ class LogIdentification(ValueEquality):
     def regressor(self, q: Any, qd: Any, qdd: Any) -> NDArray[np.float64]:
         """The (T, n, p) regressor of ``theta``: base columns, then the offset columns, then the
         position-torque columns (sin q_j, cos q_j of each of ``position_joints``)."""
-        Y = self.robot.regressor(q, qd, qdd, rotor=self.rotor, friction=self.friction)
-        if Y.ndim == 2:
-            Y = Y[None]
-        if Y.shape[-1] != len(self.parameter_names):
+        robot = self.robot
+        total = robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
+        if total != len(self.parameter_names):
             raise ValueError(
-                f"model: its regressor has {Y.shape[-1]} columns, the result expects "
+                f"model: its regressor has {total} columns, the result expects "
                 f"{len(self.parameter_names)}"
             )
-        Y = Y[..., self.independent]
+        # Only the base columns, selected in C++ (no full (T, n, P) array).
+        Y = robot.regressor(
+            q, qd, qdd, rotor=self.rotor, friction=self.friction, columns=self.independent
+        )
+        if Y.ndim == 2:
+            Y = Y[None]
         if self.offset:
             ones = np.broadcast_to(np.eye(self.n), (Y.shape[0], self.n, self.n))
             Y = np.concatenate([Y, ones], axis=2)
@@ -276,12 +285,18 @@ def identify_log(
         relative_std=np.zeros(len(names)), condition_number=np.nan, rank=0, log=prepared,
         position_joints=joints, _robot=robot,
     )
-    Y = result.regressor(prepared.q, prepared.qd, prepared.qdd)
+    # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
+    # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
+    chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
+    accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
+    for c in chunks:
+        accumulator.add(result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]),
+                        prepared.tau[c])
     # The physical fit needs the least squares only for the rank, the condition number and the
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
-    fit = least_squares(Y, prepared.tau, method=method, names=names, exclude_joints=exclude_joints,
-                        on_rank_deficient="warn" if physical else "raise")
+    fit = accumulator.solve(method=method, names=names,
+                            on_rank_deficient="warn" if physical else "raise")
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.covariance = fit.covariance
@@ -297,7 +312,9 @@ def identify_log(
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
         "notes": list(prepared.notes) + _position_notes(left_out),
-        "metrics": error_metrics(prepared.tau, Y @ result.theta),
+        "metrics": error_metrics(prepared.tau, np.concatenate(
+            [result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]) @ result.theta
+             for c in chunks])),
     }
     return result
 

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
+from .._threads import blas_single_threaded
 from ..base_parameters import BaseParameters, base_parameters
 from ..robot import Robot
 from .trajectory import (
@@ -68,6 +69,7 @@ class ExcitationResult:
     initial: FourierTrajectory = field(repr=False)  #: the feasible starting guess
 
 
+@blas_single_threaded  # many small dense products: one BLAS thread is fastest (issue 13)
 def optimize_excitation(
     robot: Robot,
     *,

@@ -20,6 +20,16 @@ struct JointTransform {
   Vector3 p = Vector3::Zero();
 
   void set(double cos_alpha, double sin_alpha, double a, double theta, double d);
+  // The same with cos/sin theta already computed.
+  void set(double cos_alpha, double sin_alpha, double a, double cos_theta, double sin_theta,
+           double d_value) {
+    ca = cos_alpha;
+    sa = sin_alpha;
+    ct = cos_theta;
+    st = sin_theta;
+    d = d_value;
+    p = Vector3(a, -sa * d, ca * d);
+  }
 
   // R x: Rz(theta) first, then Rx(alpha).
   Vector3 rotate_to_parent(const Vector3& x) const {
