@@ -12,15 +12,21 @@ import statistics
 import subprocess
 import sys
 
-CODE = ("import time; t0 = time.perf_counter(); import numpy; t1 = time.perf_counter(); "
-        "import {module}; t2 = time.perf_counter(); print(t1 - t0, t2 - t1)")
+CODE = (
+    "import time; t0 = time.perf_counter(); import numpy; t1 = time.perf_counter(); "
+    "import {module}; t2 = time.perf_counter(); print(t1 - t0, t2 - t1)"
+)
 
 
 def measure(module: str, runs: int) -> tuple[float, float]:
     numpy_times, module_times = [], []
     for _ in range(runs):
-        out = subprocess.run([sys.executable, "-c", CODE.format(module=module)],
-                             capture_output=True, text=True, check=True).stdout.split()
+        out = subprocess.run(
+            [sys.executable, "-c", CODE.format(module=module)],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.split()
         numpy_times.append(float(out[0]))
         module_times.append(float(out[1]))
     return statistics.median(numpy_times), statistics.median(module_times)

@@ -193,7 +193,13 @@ def batch(
 
 
 def batch_kernels(
-    robot: Any, pin: Any | None, model: Any, data: Any, Q: Array, Qd: Array, Qdd: Array,
+    robot: Any,
+    pin: Any | None,
+    model: Any,
+    data: Any,
+    Q: Array,
+    Qd: Array,
+    Qdd: Array,
     runs: int,
 ) -> dict[str, Any]:
     """Batch gravity, mass matrix and (rigid-body) regressor on the T states, time per state
@@ -231,9 +237,15 @@ def batch_kernels(
                 out[k] = pin.computeJointTorqueRegressor(model, data, q, qd, qdd)
             return out
 
-        calls = {name: (calls[name][0], fn) for name, fn in
-                 (("gravity", pin_gravity), ("mass_matrix", pin_crba), ("regressor", pin_regressor),
-                  ("regressor_out", pin_regressor))}
+        calls = {
+            name: (calls[name][0], fn)
+            for name, fn in (
+                ("gravity", pin_gravity),
+                ("mass_matrix", pin_crba),
+                ("regressor", pin_regressor),
+                ("regressor_out", pin_regressor),
+            )
+        }
     result: dict[str, Any] = {"states": T, "isa": _core._batch_isa()}
     for name, (ours, theirs) in calls.items():
         stats = time_interleaved([ours] + ([theirs] if theirs else []), runs, T)
@@ -245,8 +257,10 @@ def batch_kernels(
         reference = robot.rnea(Q, Qd, Qdd)
         for isa in _core._supported_batch_isas():
             _core._set_batch_isa(isa)
-            _require_agreement({f"batch rnea {isa}": _worst(robot.rnea(Q, Qd, Qdd), reference)},
-                               f"{isa} lanes vs scalar")
+            _require_agreement(
+                {f"batch rnea {isa}": _worst(robot.rnea(Q, Qd, Qdd), reference)},
+                f"{isa} lanes vs scalar",
+            )
             paths[isa] = time_interleaved([lambda: robot.rnea(Q, Qd, Qdd)], runs, T)[0]
     finally:
         _core._set_batch_isa(chosen)

@@ -343,7 +343,8 @@ def main() -> None:
         )
         kernels = py["batch_kernels"]
         print(
-            f"batch path: {kernels['isa']} (SIMD lanes, chosen at load time; CPU {result['machine']['cpu']}); "
+            f"batch path: {kernels['isa']} (SIMD lanes, chosen at load time; "
+            f"CPU {result['machine']['cpu']}); "
             "batch rnea per path, us/state: "
             + ", ".join(f"{isa} {st['median']:.3f}" for isa, st in kernels["rnea_per_path"].items())
         )

@@ -35,14 +35,18 @@ def main() -> None:
         "computed torque, exact model": ComputedTorque(robot, 100.0, 20.0, eq33),
         "computed torque, +10 % model": ComputedTorque(wrong, 100.0, 20.0, eq33),
     }
-    sensors = {"ideal sensors": {},
-               "noise 0.05 N m, 2^16 counts": {"torque_noise": 0.05, "encoder_counts": 2**16}}
+    sensors = {
+        "ideal sensors": {},
+        "noise 0.05 N m, 2^16 counts": {"torque_noise": 0.05, "encoder_counts": 2**16},
+    }
     for sensor, options in sensors.items():
         for name, law in controllers.items():
             run = simulate(robot, q0, None, 14.0, law, dt=1e-3, substeps=2, **options)
             error = np.abs(eq33(run.t)[0] - run.q).max(axis=0)
-            print(f"{sensor:28s} {name:30s} max |q_d - q| [mrad]: "
-                  + " ".join(f"{1000 * e:6.2f}" for e in error))
+            print(
+                f"{sensor:28s} {name:30s} max |q_d - q| [mrad]: "
+                + " ".join(f"{1000 * e:6.2f}" for e in error)
+            )
 
 
 if __name__ == "__main__":

@@ -26,13 +26,17 @@ def main(paths: list[str]) -> None:
 
     robot = dynid.models.kuka_lwr4()
     # One thread per worker: the C++ batch calls and BLAS already use the core they run on.
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster, \
-            Client(cluster) as client:
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster,
+        Client(cluster) as client,
+    ):
         futures = [client.submit(identify_one, path, robot) for path in paths]
         for path, result in zip(paths, client.gather(futures)):
             rel = result.training["metrics"]["relative_rms"]
-            print(f"{path}: {result.count} base parameters, rel. RMS per joint "
-                  + " ".join(f"{100 * r:.2f}%" for r in rel))
+            print(
+                f"{path}: {result.count} base parameters, rel. RMS per joint "
+                + " ".join(f"{100 * r:.2f}%" for r in rel)
+            )
 
 
 if __name__ == "__main__":

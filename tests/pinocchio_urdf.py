@@ -24,8 +24,13 @@ TOL = 1e-10  # relative to the largest entry of each result (the maths is exact)
 
 def example_robot_data(relative: str) -> Path:
     """A file of the installed example-robot-data package (a test extra)."""
-    path = Path(str(distribution("example-robot-data").locate_file(
-        f"cmeel.prefix/share/example-robot-data/robots/{relative}")))
+    path = Path(
+        str(
+            distribution("example-robot-data").locate_file(
+                f"cmeel.prefix/share/example-robot-data/robots/{relative}"
+            )
+        )
+    )
     assert path.is_file(), path
     return path
 
@@ -49,7 +54,7 @@ class Reference:
         for value, jid in zip(q, self.joints):
             joint = self.model.joints[jid]
             if joint.nq == 2:
-                out[joint.idx_q: joint.idx_q + 2] = np.cos(value), np.sin(value)
+                out[joint.idx_q : joint.idx_q + 2] = np.cos(value), np.sin(value)
             else:
                 out[joint.idx_q] = value
         return out
@@ -95,8 +100,7 @@ def relative_error(actual: np.ndarray, expected: np.ndarray) -> float:
     return float(np.max(np.abs(actual - expected)) / max(1e-12, float(np.max(np.abs(expected)))))
 
 
-def assert_matches_pinocchio(robot: Any, text: str, base_link, tip_link, seed=0,
-                             samples=8) -> None:
+def assert_matches_pinocchio(robot: Any, text: str, base_link, tip_link, seed=0, samples=8) -> None:
     """rnea, M, g (rigid body: Pinocchio has no friction) and the tip pose of ``robot`` equal
     Pinocchio's on ``text`` at random q, to TOL relative."""
     ref = reference(text, base_link, tip_link)

@@ -252,7 +252,11 @@ def arm_of(robot) -> Arm:
     """The same arm as a dynid robot, in this reference model (no drive terms)."""
     links = [params_to_physical(p) for p in robot.params]
     return Arm(
-        dh=np.array(robot.dh), joint_types=robot.joint_types, convention=robot.convention,
-        mass=np.array([m for m, _, _ in links]), com=np.array([c for _, c, _ in links]),
-        inertia_com=np.array([i for _, _, i in links]), gravity=np.array(robot.gravity_vector),
+        dh=np.array(robot.dh),
+        joint_types=robot.joint_types,
+        convention=robot.convention,
+        mass=np.array([m for m, _, _ in links]),
+        com=np.array([c for _, c, _ in links]),
+        inertia_com=np.array([i for _, _, i in links]),
+        gravity=np.array(robot.gravity_vector),
     )

@@ -20,13 +20,18 @@ L1, L2, LC1, LC2, M1, M2, I1, I2 = 1.0, 0.8, 0.45, 0.35, 3.0, 2.0, 0.25, 0.11
 
 def max_over_directions(matrix_of_direction) -> float:
     """max over unit qd = (cos p, sin p) of the spectral norm of matrix_of_direction(qd)."""
+
     def f(p: float) -> float:
         return np.linalg.norm(matrix_of_direction(np.array([np.cos(p), np.sin(p)])), 2)
 
     grid = np.linspace(0.0, 2 * np.pi, 20001)
     best = grid[np.argmax([f(p) for p in grid])]
-    res = scipy.optimize.minimize_scalar(lambda p: -f(p), bounds=(best - 1e-3, best + 1e-3),
-                                         method="bounded", options={"xatol": 1e-12})
+    res = scipy.optimize.minimize_scalar(
+        lambda p: -f(p),
+        bounds=(best - 1e-3, best + 1e-3),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
     return -res.fun
 
 
@@ -74,8 +79,9 @@ def test_attaining_points_reproduce_the_values_and_lie_in_the_ranges():
     assert b.k0.value == pytest.approx(eig0[0], rel=1e-12)
     assert b.k1.value == pytest.approx(eig1[-1], rel=1e-12)
     assert np.linalg.norm(b.k4.qd) == pytest.approx(1.0, rel=1e-12)
-    assert b.k4.value == pytest.approx(np.linalg.norm(robot.coriolis_matrix(b.k4.q, b.k4.qd), 2),
-                                       rel=1e-12)
+    assert b.k4.value == pytest.approx(
+        np.linalg.norm(robot.coriolis_matrix(b.k4.q, b.k4.qd), 2), rel=1e-12
+    )
     assert b.k6.value == pytest.approx(np.linalg.norm(robot.gravity(b.k6.q)), rel=1e-12)
     assert b.samples == 1000 and b.starts == 2
     np.testing.assert_array_equal(b.qlim, robot.qlim)
@@ -103,9 +109,12 @@ def test_more_samples_never_give_a_worse_estimate():
 def polar_arm(mass2: float, offset: float, q2_range: tuple[float, float]) -> dynid.Robot:
     """R joint about the base z axis, then a P joint along z1, which lies in the base x-y plane;
     gravity along -y (a vertical plane). Link 2's CoM on the prismatic axis at q2 + offset."""
-    robot = dynid.Robot.from_dh([[0, np.pi / 2, 0, 0], [0, 0, 0, 0]], "RP",
-                                gravity=(0.0, -G0, 0.0),
-                                qlim=[[-np.pi, np.pi], list(q2_range)])
+    robot = dynid.Robot.from_dh(
+        [[0, np.pi / 2, 0, 0], [0, 0, 0, 0]],
+        "RP",
+        gravity=(0.0, -G0, 0.0),
+        qlim=[[-np.pi, np.pi], list(q2_range)],
+    )
     robot.set_link(0, 1.5, (0, 0, 0), np.diag([0.02, 0.03, 0.04]))
     robot.set_link(1, mass2, (0, 0, offset), np.diag([0.05, 0.06, 0.02]))
     return robot

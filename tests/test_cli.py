@@ -40,8 +40,17 @@ def files(tmp_path_factory):
 
 def test_identify_validate_and_info(files, tmp_path, capsys):
     out, check = tmp_path / "ident", tmp_path / "check"
-    argv = ["identify", str(files / "train.npz"), "--model", str(files / "arm.json"),
-            "--friction", "--method", "ols", "--output", str(out)]
+    argv = [
+        "identify",
+        str(files / "train.npz"),
+        "--model",
+        str(files / "arm.json"),
+        "--friction",
+        "--method",
+        "ols",
+        "--output",
+        str(out),
+    ]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert "[5/5] wrote" in printed and "condition number" in printed and "Fs2" in printed
@@ -66,13 +75,37 @@ def test_identify_validate_and_info(files, tmp_path, capsys):
 
 
 def test_preparation_options_reach_the_result(files, tmp_path, capsys):
-    argv = ["identify", str(files / "train.npz"), "--model", "planar_2r", "--friction",
-            "--skip", "10", "--cutoff", "8", "--order", "2", "--decimate", "2",
-            "--min-velocity", "0.01", "--outliers", "8", "--offset", "--output", str(tmp_path)]
+    argv = [
+        "identify",
+        str(files / "train.npz"),
+        "--model",
+        "planar_2r",
+        "--friction",
+        "--skip",
+        "10",
+        "--cutoff",
+        "8",
+        "--order",
+        "2",
+        "--decimate",
+        "2",
+        "--min-velocity",
+        "0.01",
+        "--outliers",
+        "8",
+        "--offset",
+        "--output",
+        str(tmp_path),
+    ]
     assert main(argv) == 0
     training = json.loads((tmp_path / "result.json").read_text())["training"]
-    assert training["preparation"] == {"cutoff": 8.0, "decimate": 2, "order": 2,
-                                       "min_velocity": 0.01, "outlier_k": 8.0}
+    assert training["preparation"] == {
+        "cutoff": 8.0,
+        "decimate": 2,
+        "order": 2,
+        "min_velocity": 0.01,
+        "outlier_k": 8.0,
+    }
     notes = " ".join(training["notes"])
     assert "skipped the first 10 samples" in notes and "order-2 Butterworth 8 Hz" in notes
     assert "|qd| < 0.01" in notes
@@ -104,7 +137,10 @@ def test_as_a_process(files):
     """The installed entry point: a bad input is one line on stderr and exit status 2."""
     done = subprocess.run(
         [sys.executable, "-m", "dynid.cli", "identify", str(files / "no_tau.npz")],
-        check=False, capture_output=True, text=True, timeout=120,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert done.returncode == 2
     assert done.stderr.startswith("dynid identify: error: ") and done.stderr.count("\n") == 1
@@ -121,8 +157,23 @@ def test_identify_position_torque(files, tmp_path, capsys):
     tau[:, 1] += 0.3 * np.sin(log.q[:, 1]) - 0.2 * np.cos(log.q[:, 1])
     save_log(dynid.io.Log(t=log.t, q=log.q, tau=tau, qd=log.qd, qdd=log.qdd), tmp_path / "p.npz")
     out = tmp_path / "ident"
-    assert main(["identify", str(tmp_path / "p.npz"), "--model", str(files / "arm.json"),
-                 "--friction", "--position-torque", "--method", "ols", "--output", str(out)]) == 0
+    assert (
+        main(
+            [
+                "identify",
+                str(tmp_path / "p.npz"),
+                "--model",
+                str(files / "arm.json"),
+                "--friction",
+                "--position-torque",
+                "--method",
+                "ols",
+                "--output",
+                str(out),
+            ]
+        )
+        == 0
+    )
     printed = capsys.readouterr().out
     assert "not on joint(s) 1" in printed and "kc2" in printed
     result = load_result(out)

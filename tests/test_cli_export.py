@@ -17,8 +17,22 @@ PRIOR = "tests/data/urdf/kuka_lwr4.urdf"
 @pytest.fixture(scope="module")
 def physical_result(tmp_path_factory):
     out = tmp_path_factory.mktemp("cli") / "physical"
-    status = dynid.cli.main(["identify", LOG, "--skip", "3000", "--rotor", "--friction",
-                             "--offset", "--physical", "--prior", PRIOR, "--output", str(out)])
+    status = dynid.cli.main(
+        [
+            "identify",
+            LOG,
+            "--skip",
+            "3000",
+            "--rotor",
+            "--friction",
+            "--offset",
+            "--physical",
+            "--prior",
+            PRIOR,
+            "--output",
+            str(out),
+        ]
+    )
     assert status == 0
     return out
 
@@ -46,8 +60,9 @@ def test_export_writes_the_identified_robot(physical_result, tmp_path) -> None:
         assert np.max(np.abs(tau - reference)) <= 1e-12 * np.max(np.abs(reference))
 
 
-def test_export_refuses_least_squares_results_and_existing_files(physical_result, tmp_path,
-                                                                  capsys) -> None:
+def test_export_refuses_least_squares_results_and_existing_files(
+    physical_result, tmp_path, capsys
+) -> None:
     plain = tmp_path / "plain"
     assert dynid.cli.main(["identify", LOG, "--skip", "4500", "--output", str(plain)]) == 0
     capsys.readouterr()
@@ -61,7 +76,8 @@ def test_export_refuses_least_squares_results_and_existing_files(physical_result
     q = np.random.default_rng(2).uniform(-2, 2, (10, 6))
     expected = dynid.models.ur5().gravity(q)
     assert np.max(np.abs(dynid.Robot.from_urdf(target).gravity(q) - expected)) <= 1e-12 * np.max(
-        np.abs(expected))
+        np.abs(expected)
+    )
 
 
 def test_prior_only_with_physical(tmp_path, capsys) -> None:
@@ -75,8 +91,21 @@ def test_residual_command(tmp_path, capsys) -> None:
     from dynid.observer import residual_from_log
 
     out = tmp_path / "residual"
-    status = dynid.cli.main(["residual", "kuka_lwr4", LOG, "--skip", "4000", "--gain", "10",
-                             "--threshold", "1", "--output", str(out)])
+    status = dynid.cli.main(
+        [
+            "residual",
+            "kuka_lwr4",
+            LOG,
+            "--skip",
+            "4000",
+            "--gain",
+            "10",
+            "--threshold",
+            "1",
+            "--output",
+            str(out),
+        ]
+    )
     assert status == 0
     saved = np.load(out / "residual.npz")
     expected = residual_from_log(dynid.models.kuka_lwr4(), dynid.load_log(LOG, skip=4000), 10.0)

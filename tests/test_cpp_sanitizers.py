@@ -21,8 +21,9 @@ import os
 import re
 import subprocess
 
-import dynid.cmake
 import pytest
+
+import dynid.cmake
 from test_cpp_package import REPO, find_compiler, find_tool
 
 SANITIZER_REPORT = re.compile(
@@ -37,7 +38,8 @@ def test_cpp_tests_pass_under_address_and_undefined_sanitizers(tmp_path, record_
     if compiler is None or cmake is None or ctest is None:
         assert not os.environ.get("CI"), f"CI needs a C++ compiler and cmake: {compiler}, {cmake}"
         pytest.skip(
-            f"needs a C++ compiler and cmake/ctest: compiler={compiler}, cmake={cmake}, ctest={ctest}"
+            "needs a C++ compiler and cmake/ctest: "
+            f"compiler={compiler}, cmake={cmake}, ctest={ctest}"
         )
     build = tmp_path / "build"
     configure = [
@@ -117,6 +119,12 @@ def test_dynid_hpp_includes_every_public_header_and_internals_are_in_detail():
     # The internals left the public headers.
     for name in public:
         text = (include / name).read_text()
-        for internal in ("propagate_motion", "accumulate_wrenches", "struct JointTransform",
-                         "struct LinkOffset", "struct JointGeometry", "update_joint_transforms"):
+        for internal in (
+            "propagate_motion",
+            "accumulate_wrenches",
+            "struct JointTransform",
+            "struct LinkOffset",
+            "struct JointGeometry",
+            "update_joint_transforms",
+        ):
             assert internal not in text, (name, internal)

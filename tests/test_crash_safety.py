@@ -76,7 +76,8 @@ def test_objects_made_by_new_without_init_raise():
                 expect(TypeError, not_initialised, lambda: repr(robot))
             expect(TypeError, not_initialised, lambda: robot.params)
             expect(TypeError, not_initialised, lambda: robot.gravity(np.zeros(7)))
-            expect(TypeError, not_initialised, lambda: robot.rnea(np.zeros(7), np.zeros(7), np.zeros(7)))
+            zero = np.zeros(7)
+            expect(TypeError, not_initialised, lambda: robot.rnea(zero, zero, zero))
             expect(TypeError, not_initialised, lambda: setattr(robot, "Fv", np.zeros(7)))
         rls = RecursiveLeastSquares.__new__(RecursiveLeastSquares)
         expect(TypeError, not_initialised, lambda: rls.p)
@@ -110,7 +111,8 @@ def test_input_that_cannot_be_copied_is_a_memory_error():
         expect(MemoryError, "qd: not enough memory", lambda: robot.coriolis(np.zeros(7), huge))
         expect(MemoryError, "q: not enough memory", lambda: robot.mass_matrix(small_ints))
         rls = dynid.RecursiveLeastSquares(7)
-        expect(MemoryError, "Y_k: not enough memory", lambda: rls.update(huge, np.broadcast_to(0.0, (10**9,))))
+        huge_tau = np.broadcast_to(0.0, (10**9,))
+        expect(MemoryError, "Y_k: not enough memory", lambda: rls.update(huge, huge_tau))
         # The interpreter is still usable and the model unchanged.
         assert robot.gravity(np.zeros(7)).shape == (7,)
         print("ok")
@@ -146,8 +148,9 @@ def test_batch_whose_threads_cannot_start_runs_on_those_that_did():
 def test_rls_update_that_overflows_the_covariance_raises_and_keeps_the_state():
     """An update with |Y| = 1e200 left theta finite but the covariance all NaN, silently: now
     ValueError naming the inputs, and theta and the covariance are exactly those before it."""
-    import dynid
     import numpy as np
+
+    import dynid
 
     rls = dynid.RecursiveLeastSquares(3)
     rls.update(np.array([[1.0, 2.0, 3.0]]), [1.0])
@@ -210,7 +213,9 @@ assert np.array_equal(rls.theta, theta), "interrupted update_batch changed the e
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a subprocess is POSIX")
 @pytest.mark.parametrize(
-    ("threads", "what"), [(1, "model"), (2, "model"), (1, "rls")], ids=["model", "model-2-threads", "rls"]
+    ("threads", "what"),
+    [(1, "model"), (2, "model"), (1, "rls")],
+    ids=["model", "model-2-threads", "rls"],
 )
 def test_ctrl_c_interrupts_a_long_batch(threads, what):
     """Ctrl-C during a multi-second batch (GIL released) raises KeyboardInterrupt within ~0.1 s

@@ -42,8 +42,15 @@ def test_demo_writes_json_matching_its_report(demo):
     on_disk = json.loads((out / "demo.json").read_text())
     assert on_disk == json.loads(json.dumps(report))
     assert on_disk["settings"]["train"] == 60 and on_disk["settings"]["validation"] == 20
-    for key in ("coefficients", "zero_elements", "gravity_errors", "inertia_errors",
-                "condition_numbers", "payload", "plots"):
+    for key in (
+        "coefficients",
+        "zero_elements",
+        "gravity_errors",
+        "inertia_errors",
+        "condition_numbers",
+        "payload",
+        "plots",
+    ):
         assert key in on_disk, key
 
 

@@ -47,8 +47,13 @@ def test_the_quoted_numbers_are_what_the_examples_print():
     scaling = run(blocks("Uniform time scaling")[0])
     assert "k = 0.346" in scaling
     bounds = run(blocks("Bounds on the dynamic terms")[0])
-    for text in ("k0 =    0.0707", "k1 =    4.3534", "k4 =    2.4231", "k6 =   55.9417",
-                 "samples alone:    1.9346"):
+    for text in (
+        "k0 =    0.0707",
+        "k1 =    4.3534",
+        "k4 =    2.4231",
+        "k6 =   55.9417",
+        "samples alone:    1.9346",
+    ):
         assert text in bounds, bounds
     payload = run(blocks("Payload estimation")[0])
     assert "m = 0.7995 +- 0.0004 kg" in payload

@@ -103,13 +103,15 @@ def test_noise_free_tau_J_equals_the_rigid_robots_rnea(noise_free):
     error = np.abs(ident.rnea(q, qd, qdd) - tau).max()
     assert error <= 1e-9 * np.abs(tau).max(), error
     # one sample at a time as well (SPEC §2 shapes)
-    np.testing.assert_allclose(ident.rnea(q[0], qd[0], qdd[0]), tau[0], rtol=0,
-                               atol=1e-9 * np.abs(tau).max())
+    np.testing.assert_allclose(
+        ident.rnea(q[0], qd[0], qdd[0]), tau[0], rtol=0, atol=1e-9 * np.abs(tau).max()
+    )
     # and against Lagrange's equations on the reference model (finite differences, ~1e-7)
     arm = ref.arm_of(truth)
     lagrange = ref.lagrange_torque(arm, q[1], qd[1], qdd[1])
-    np.testing.assert_allclose(ident.rnea(q[1], qd[1], qdd[1]), lagrange, rtol=0,
-                               atol=1e-6 * np.abs(lagrange).max())
+    np.testing.assert_allclose(
+        ident.rnea(q[1], qd[1], qdd[1]), lagrange, rtol=0, atol=1e-6 * np.abs(lagrange).max()
+    )
 
 
 def test_identified_coriolis_matrix_is_the_christoffel_one(noise_free):
@@ -124,10 +126,12 @@ def test_identified_coriolis_matrix_is_the_christoffel_one(noise_free):
         c = ident.coriolis(q, qd)
         scale = np.abs(ident.mass_matrix(q)).max() * np.abs(qd).max() ** 2
         np.testing.assert_allclose(S @ qd, c, rtol=0, atol=1e-12 * scale)
-        dM = np.array([
-            (ident.mass_matrix(q + h * e) - ident.mass_matrix(q - h * e)) / (2 * h)
-            for e in np.eye(n)
-        ])  # dM[k] = dM/dq_k
+        dM = np.array(
+            [
+                (ident.mass_matrix(q + h * e) - ident.mass_matrix(q - h * e)) / (2 * h)
+                for e in np.eye(n)
+            ]
+        )  # dM[k] = dM/dq_k
         christoffel = 0.5 * (dM.transpose(1, 2, 0) + dM.transpose(1, 0, 2) - dM)  # [i, j, k]
         S_ref = christoffel @ qd
         np.testing.assert_allclose(S, S_ref, rtol=0, atol=1e-7 * scale / np.abs(qd).max())
@@ -177,8 +181,10 @@ def test_joint_1_gravity_row_is_left_out_by_default():
 
 
 def _true_coefficients(truth):
-    return (dynid.base_parameters(truth, "gravity").values(truth),
-            dynid.base_parameters(truth, "inertia").values(truth))
+    return (
+        dynid.base_parameters(truth, "gravity").values(truth),
+        dynid.base_parameters(truth, "inertia").values(truth),
+    )
 
 
 def test_errors_shrink_like_one_over_sqrt_N():
@@ -329,8 +335,9 @@ def test_the_papers_M76_closed_form_holds_for_the_true_robot():
     truth = dynid.models.kuka_lwr4()
     q = truth.random_configurations(30, seed=18)
     M = truth.mass_matrix(q)
-    np.testing.assert_allclose(M[:, 6, 5], paper_M76(truth.params[6], q[:, 6]), rtol=0,
-                               atol=1e-12 * np.abs(M).max())
+    np.testing.assert_allclose(
+        M[:, 6, 5], paper_M76(truth.params[6], q[:, 6]), rtol=0, atol=1e-12 * np.abs(M).max()
+    )
     assert np.abs(M[:, 6, 5]).max() > 1e-6  # non-zero for the plain model
 
 
@@ -364,8 +371,9 @@ def test_no_zero_element_is_reported_for_the_plain_model():
         assert ident.zero_elements == []
     ident = identify(truth, 150, seed=21)
     M = ident.mass_matrix(q)
-    np.testing.assert_allclose(M[:, 6, 5], paper_M76(truth.params[6], q[:, 6]), rtol=0,
-                               atol=1e-9 * np.abs(M).max())
+    np.testing.assert_allclose(
+        M[:, 6, 5], paper_M76(truth.params[6], q[:, 6]), rtol=0, atol=1e-9 * np.abs(M).max()
+    )
 
 
 # --- bad input -----------------------------------------------------------------------------------
@@ -373,8 +381,12 @@ def test_no_zero_element_is_reported_for_the_plain_model():
 
 @pytest.mark.parametrize(
     ("field", "value"),
-    [("q", np.zeros((5, 6))), ("g", np.zeros((4, 7))), ("M", np.zeros((5, 7, 6))),
-     ("g", np.full((5, 7), np.nan))],
+    [
+        ("q", np.zeros((5, 6))),
+        ("g", np.zeros((4, 7))),
+        ("M", np.zeros((5, 7, 6))),
+        ("g", np.full((5, 7), np.nan)),
+    ],
 )
 def test_bad_readings_raise_value_error_naming_them(field, value):
     truth = dynid.models.kuka_lwr4()

@@ -50,7 +50,6 @@ TRAJECTORY = excitation.FourierTrajectory(1.0, np.ones((2, 3)), np.zeros((2, 3))
 LONG = np.column_stack([np.sin(np.linspace(0, 20, 400)), np.cos(np.linspace(0, 13, 400))])
 
 
-
 def _from_controller(q, g, M):
     # The 2R's joint 1 is not vertical: keep its gravity row.
     return identify_from_controller(PLANAR, q, g, M, exclude_gravity_joints=())
@@ -65,19 +64,29 @@ CASES = [
     ("identify_from_controller q", lambda v: _from_controller(v, G, M), "q", Q),
     ("identify_from_controller g", lambda v: _from_controller(Q, v, M), "g", G),
     ("identify_from_controller M", lambda v: _from_controller(Q, G, v), "M", M),
-    ("payload before",
-     lambda v: payload_mass_estimates(GRAVITY_BASE, v, np.ones(GRAVITY_BASE.count)), "before",
-     np.ones(GRAVITY_BASE.count)),
-    ("payload after",
-     lambda v: payload_mass_estimates(GRAVITY_BASE, np.ones(GRAVITY_BASE.count), v), "after",
-     np.ones(GRAVITY_BASE.count)),
+    (
+        "payload before",
+        lambda v: payload_mass_estimates(GRAVITY_BASE, v, np.ones(GRAVITY_BASE.count)),
+        "before",
+        np.ones(GRAVITY_BASE.count),
+    ),
+    (
+        "payload after",
+        lambda v: payload_mass_estimates(GRAVITY_BASE, np.ones(GRAVITY_BASE.count), v),
+        "after",
+        np.ones(GRAVITY_BASE.count),
+    ),
     ("Log t", lambda v: Log(t=v, q=SIG, tau=SIG), "t", TIME),
     ("Log q", lambda v: Log(t=TIME, q=v, tau=SIG), "q", SIG),
     ("Log tau", lambda v: Log(t=TIME, q=SIG, tau=v), "tau", SIG),
     ("Log qd", lambda v: Log(t=TIME, q=SIG, tau=SIG, qd=v), "qd", SIG),
     ("Log qdd", lambda v: Log(t=TIME, q=SIG, tau=SIG, qdd=v), "qdd", SIG),
-    ("prepare_log reference_tau",
-     lambda v: prepare_log(LOG, outlier_k=5.0, reference_tau=v), "reference_tau", SIG),
+    (
+        "prepare_log reference_tau",
+        lambda v: prepare_log(LOG, outlier_k=5.0, reference_tau=v),
+        "reference_tau",
+        SIG,
+    ),
     ("lowpass x", lambda v: signal.lowpass(v, 100.0, 5.0), "x", LONG),
     ("differentiate x", lambda v: signal.differentiate(v, fs=100.0), "x", SIG),
     ("differentiate t", lambda v: signal.differentiate(SIG, t=v), "t", TIME),
@@ -85,18 +94,31 @@ CASES = [
     ("check_time t", lambda v: signal.check_time(v), "t", TIME),
     ("moving_mask_min_velocity qd", lambda v: signal.moving_mask_min_velocity(v, 0.1), "qd", SIG),
     ("outlier_mask residual", lambda v: signal.outlier_mask(v, 5.0), "residual", SIG),
-    ("FourierTrajectory a",
-     lambda v: excitation.FourierTrajectory(1.0, v, np.zeros((2, 3)), np.zeros(2)), "a",
-     np.ones((2, 3))),
-    ("FourierTrajectory b",
-     lambda v: excitation.FourierTrajectory(1.0, np.ones((2, 3)), v, np.zeros(2)), "b",
-     np.ones((2, 3))),
-    ("FourierTrajectory q0",
-     lambda v: excitation.FourierTrajectory(1.0, np.ones((2, 3)), np.zeros((2, 3)), v), "q0",
-     np.zeros(2)),
+    (
+        "FourierTrajectory a",
+        lambda v: excitation.FourierTrajectory(1.0, v, np.zeros((2, 3)), np.zeros(2)),
+        "a",
+        np.ones((2, 3)),
+    ),
+    (
+        "FourierTrajectory b",
+        lambda v: excitation.FourierTrajectory(1.0, np.ones((2, 3)), v, np.zeros(2)),
+        "b",
+        np.ones((2, 3)),
+    ),
+    (
+        "FourierTrajectory q0",
+        lambda v: excitation.FourierTrajectory(1.0, np.ones((2, 3)), np.zeros((2, 3)), v),
+        "q0",
+        np.zeros(2),
+    ),
     ("FourierTrajectory.evaluate t", lambda v: TRAJECTORY.evaluate(v), "t", TIME),
-    ("FourierTrajectory.from_vector x",
-     lambda v: excitation.FourierTrajectory.from_vector(v, 2, 3, 1.0), "x", np.ones(14)),
+    (
+        "FourierTrajectory.from_vector x",
+        lambda v: excitation.FourierTrajectory.from_vector(v, 2, 3, 1.0),
+        "x",
+        np.ones(14),
+    ),
     ("error_metrics measured", lambda v: error_metrics(v, SIG), "measured", SIG),
     ("error_metrics predicted", lambda v: error_metrics(SIG, v), "predicted", SIG),
 ]
@@ -251,8 +273,13 @@ def test_predict_overflow_raises():
 
 @pytest.mark.parametrize(
     ("argv", "argument"),
-    [(["--train", "0"], "train"), (["--train", "1"], "train"), (["--train", "2"], "train"),
-     (["--train", "-5"], "train"), (["--validation", "0"], "validation")],
+    [
+        (["--train", "0"], "train"),
+        (["--train", "1"], "train"),
+        (["--train", "2"], "train"),
+        (["--train", "-5"], "train"),
+        (["--validation", "0"], "validation"),
+    ],
 )
 def test_demo_with_too_few_configurations_exits_2_with_one_line(tmp_path, capsys, argv, argument):
     out = tmp_path / "demo"
@@ -284,7 +311,9 @@ def test_real_array_helper():
 
     given = np.arange(6.0).reshape(2, 3)
     assert real_array(given, "x") is given  # float64 input is not copied
-    np.testing.assert_array_equal(real_array([[1, 2], [3, 4]], "x", ndim=2), [[1.0, 2.0], [3.0, 4.0]])
+    np.testing.assert_array_equal(
+        real_array([[1, 2], [3, 4]], "x", ndim=2), [[1.0, 2.0], [3.0, 4.0]]
+    )
     assert real_array(np.arange(3, dtype=np.uint8), "x").dtype == np.float64
     with pytest.raises(ValueError, match=r"^x: expected a 1-dimensional array, got shape \(2, 3\)"):
         real_array(given, "x", ndim=1)

@@ -30,13 +30,15 @@ def jacobians_by_finite_differences(robot, q, qd, u):
     x = np.concatenate([q, qd])
     A = np.column_stack(
         [
-            (state_function(robot, x + STEP * e, u) - state_function(robot, x - STEP * e, u)) / (2 * STEP)
+            (state_function(robot, x + STEP * e, u) - state_function(robot, x - STEP * e, u))
+            / (2 * STEP)
             for e in np.eye(2 * n)
         ]
     )
     B = np.column_stack(
         [
-            (state_function(robot, x, u + STEP * e) - state_function(robot, x, u - STEP * e)) / (2 * STEP)
+            (state_function(robot, x, u + STEP * e) - state_function(robot, x, u - STEP * e))
+            / (2 * STEP)
             for e in np.eye(n)
         ]
     )
@@ -44,7 +46,9 @@ def jacobians_by_finite_differences(robot, q, qd, u):
 
 
 def assert_close(actual, expected, rtol):
-    np.testing.assert_allclose(actual, expected, rtol=0, atol=rtol * max(1.0, np.abs(expected).max()))
+    np.testing.assert_allclose(
+        actual, expected, rtol=0, atol=rtol * max(1.0, np.abs(expected).max())
+    )
 
 
 @pytest.mark.parametrize("case", ARM_CASES)
@@ -74,7 +78,9 @@ def test_at_an_equilibrium_matches_finite_differences_without_coulomb():
     assert_close(A, A_fd, FD_RTOL)
     assert_close(B, B_fd, FD_RTOL)
     np.testing.assert_allclose(
-        A[robot.n :, robot.n :], -np.linalg.solve(robot.mass_matrix(q), np.diag(robot.Fv)), atol=1e-12
+        A[robot.n :, robot.n :],
+        -np.linalg.solve(robot.mass_matrix(q), np.diag(robot.Fv)),
+        atol=1e-12,
     )
 
 

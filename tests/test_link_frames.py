@@ -26,8 +26,11 @@ URDF = "kuka_lwr4.urdf (HEAD)"
 def arm_table(convention: str) -> dynid.Robot:
     rows = SOURCE["dh"][convention]["rows"]
     a, alpha = ("a", "alpha") if convention == "standard" else ("a_prev", "alpha_prev")
-    return dynid.Robot.from_dh([[r[a], r[alpha], r["d"], r["theta_offset"]] for r in rows],
-                               convention=convention, params=SOURCE["params"][URDF][convention])
+    return dynid.Robot.from_dh(
+        [[r[a], r[alpha], r["d"], r["theta_offset"]] for r in rows],
+        convention=convention,
+        params=SOURCE["params"][URDF][convention],
+    )
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])
@@ -44,8 +47,7 @@ def test_the_arms_tables_map_to_the_prior_file(convention):
     rng = np.random.default_rng(1)
     q = lwr.random_configurations(30, seed=1)
     qd, qdd = rng.uniform(-2, 2, (2, 30, 7))
-    np.testing.assert_allclose(mapped.rnea(q, qd, qdd), source.rnea(q, qd, qdd), rtol=0,
-                               atol=1e-12)
+    np.testing.assert_allclose(mapped.rnea(q, qd, qdd), source.rnea(q, qd, qdd), rtol=0, atol=1e-12)
 
 
 def test_link_frames_end_at_fkine():
@@ -84,13 +86,15 @@ def test_a_prior_in_other_frames_is_mapped_by_the_physical_fit():
     Y = lwr.regressor(q, qd, qdd)
     tau = truth.rigid_body().rnea(q, qd, qdd)
     fit = physical_least_squares(lwr, Y, tau, prior=arm_table("modified"), prior_weight=1e-4)
-    np.testing.assert_allclose(fit.params, truth.params, rtol=0,
-                               atol=1e-6 * np.abs(truth.params).max())
+    np.testing.assert_allclose(
+        fit.params, truth.params, rtol=0, atol=1e-6 * np.abs(truth.params).max()
+    )
     dh = lwr.dh.copy()
     dh[2, 1] *= -1
     with pytest.raises(ValueError, match=r"^prior:"):
-        physical_least_squares(lwr, Y, tau, prior=dynid.Robot.from_dh(dh, params=truth.params),
-                               prior_weight=1e-4)
+        physical_least_squares(
+            lwr, Y, tau, prior=dynid.Robot.from_dh(dh, params=truth.params), prior_weight=1e-4
+        )
 
 
 def test_the_lwr4_urdf_maps_to_the_prior_file():

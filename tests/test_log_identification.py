@@ -23,8 +23,13 @@ from dynid.log_identification import identify_log, validate_log
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
-def fourier_log(robot: dynid.Robot, seed: int, seconds: float = 5.0, fs: float = 100.0,
-                offset: np.ndarray | None = None) -> Log:
+def fourier_log(
+    robot: dynid.Robot,
+    seed: int,
+    seconds: float = 5.0,
+    fs: float = 100.0,
+    offset: np.ndarray | None = None,
+) -> Log:
     """A periodic 3-harmonic trajectory per joint (base frequency 0.2 Hz) and its exact torque."""
     rng = np.random.default_rng(seed)
     n, w = robot.n, 2 * np.pi * 0.2
@@ -47,8 +52,9 @@ def lwr() -> dynid.Robot:
 
 @pytest.fixture(scope="module")
 def lwr_result(lwr):
-    return identify_log(fourier_log(lwr, 1), lwr, rotor=True, friction=True, offset=True,
-                        method="wls")
+    return identify_log(
+        fourier_log(lwr, 1), lwr, rotor=True, friction=True, offset=True, method="wls"
+    )
 
 
 @pytest.mark.parametrize("method", ["ols", "wls"])
@@ -59,25 +65,29 @@ def test_exact_log_gives_the_true_base_parameters(lwr, method, rotor, friction):
         truth.Ia = np.zeros(truth.n)
     if not friction:
         truth.Fv, truth.Fs = np.zeros(truth.n), np.zeros(truth.n)
-    result = identify_log(fourier_log(truth, 1), lwr, rotor=rotor, friction=friction,
-                          method=method)
+    result = identify_log(fourier_log(truth, 1), lwr, rotor=rotor, friction=friction, method=method)
     expected = dynid.base_parameters(truth, rotor=rotor, friction=friction).values(truth)
     assert result.rank == expected.size == result.theta.size
-    np.testing.assert_allclose(result.theta, expected, rtol=0,
-                               atol=1e-8 * np.abs(expected).max())
+    np.testing.assert_allclose(result.theta, expected, rtol=0, atol=1e-8 * np.abs(expected).max())
     assert np.all(result.training["metrics"]["relative_rms"] < 1e-9)
 
 
 def test_offsets_are_recovered_with_the_base_parameters(lwr, lwr_result):
     offset = np.linspace(-0.6, 0.6, lwr.n)
-    result = identify_log(fourier_log(lwr, 1, offset=offset), lwr, rotor=True, friction=True,
-                          offset=True, method="ols")
+    result = identify_log(
+        fourier_log(lwr, 1, offset=offset),
+        lwr,
+        rotor=True,
+        friction=True,
+        offset=True,
+        method="ols",
+    )
     expected = dynid.base_parameters(lwr, rotor=True, friction=True).values(lwr)
     scale = np.abs(expected).max()
-    np.testing.assert_allclose(result.theta[:-lwr.n], expected, rtol=0, atol=1e-8 * scale)
-    np.testing.assert_allclose(result.theta[-lwr.n:], offset, rtol=0, atol=1e-8 * scale)
-    assert result.names[-lwr.n:] == [f"off{j}" for j in range(1, lwr.n + 1)]
-    np.testing.assert_allclose(lwr_result.theta[-lwr.n:], 0.0, atol=1e-8 * scale)
+    np.testing.assert_allclose(result.theta[: -lwr.n], expected, rtol=0, atol=1e-8 * scale)
+    np.testing.assert_allclose(result.theta[-lwr.n :], offset, rtol=0, atol=1e-8 * scale)
+    assert result.names[-lwr.n :] == [f"off{j}" for j in range(1, lwr.n + 1)]
+    np.testing.assert_allclose(lwr_result.theta[-lwr.n :], 0.0, atol=1e-8 * scale)
 
 
 def test_prediction_on_another_trajectory_is_rnea(lwr, lwr_result, monkeypatch):
@@ -110,8 +120,9 @@ def test_validate_log_reports_the_added_noise(lwr, lwr_result):
 
 def test_preparation_is_applied_and_recorded(lwr):
     log = fourier_log(lwr, 2)
-    result = identify_log(log.replace(qd=None, qdd=None), lwr,
-                          preparation={"decimate": np.int64(2), "cutoff": None})
+    result = identify_log(
+        log.replace(qd=None, qdd=None), lwr, preparation={"decimate": np.int64(2), "cutoff": None}
+    )
     assert result.training["samples"] == (log.T + 1) // 2
     assert result.training["preparation"] == {"decimate": 2}
     json.dumps(result.training["preparation"])  # plain Python numbers
@@ -129,8 +140,19 @@ def test_save_and_load_round_trip(lwr, lwr_result, tmp_path):
         loaded = load_result(source)
         for key in ("theta", "std", "relative_std", "beta", "independent"):
             np.testing.assert_array_equal(getattr(loaded, key), getattr(lwr_result, key))
-        for key in ("names", "expressions", "parameter_names", "rank", "condition_number",
-                    "rotor", "friction", "offset", "method", "excluded", "model"):
+        for key in (
+            "names",
+            "expressions",
+            "parameter_names",
+            "rank",
+            "condition_number",
+            "rotor",
+            "friction",
+            "offset",
+            "method",
+            "excluded",
+            "model",
+        ):
             assert getattr(loaded, key) == getattr(lwr_result, key), key
         assert "params" not in loaded.model  # the prior parameters are not part of the result
         other = fourier_log(lwr, 4, seconds=1.0)
@@ -141,6 +163,7 @@ def test_save_and_load_round_trip(lwr, lwr_result, tmp_path):
 def _corrupt(key, value):
     def change(data):
         data[key] = value
+
     return change
 
 
@@ -189,9 +212,11 @@ def test_bad_input(lwr, lwr_result):
     six = Log(t=log.t, q=log.q[:, :6], tau=log.tau[:, :6])
     with pytest.raises(ValueError, match="log: has 6 joints"):
         lwr_result.predict(six)
-    still = log.replace(q=np.column_stack([log.q[:, :6], np.zeros(log.T)]),
-                        qd=np.column_stack([log.qd[:, :6], np.zeros(log.T)]),
-                        qdd=np.column_stack([log.qdd[:, :6], np.zeros(log.T)]))
+    still = log.replace(
+        q=np.column_stack([log.q[:, :6], np.zeros(log.T)]),
+        qd=np.column_stack([log.qd[:, :6], np.zeros(log.T)]),
+        qdd=np.column_stack([log.qdd[:, :6], np.zeros(log.T)]),
+    )
     with pytest.raises(RankDeficientError):  # joint 7 never moves: its parameters are unseen
         identify_log(still, lwr, rotor=True)
 

@@ -49,9 +49,13 @@ def test_lwr4plus_tables_of_the_data_reproduce_pinocchio(kind, tmp_path):
     pinocchio's RNEA on the URDF (an independent implementation) to 1e-10 N m."""
     source = json.loads((DATA / "kuka_lwr4_dh.json").read_text())
     urdf = "kuka_lwr4.urdf (HEAD)"
-    model = {"convention": kind, "joint_types": source["dh"][kind]["joint_types"],
-             "gravity": source["check_sample"][urdf]["gravity"],
-             "rows": source["dh"][kind]["rows"], "params": source["params"][urdf][kind]}
+    model = {
+        "convention": kind,
+        "joint_types": source["dh"][kind]["joint_types"],
+        "gravity": source["check_sample"][urdf]["gravity"],
+        "rows": source["dh"][kind]["rows"],
+        "params": source["params"][urdf][kind],
+    }
     (tmp_path / "lwr.json").write_text(json.dumps(model))
     robot = load_model(tmp_path / "lwr.json")
     sample = source["check_sample"][urdf]
@@ -84,13 +88,18 @@ def test_rows_as_lists_and_defaults():
     np.testing.assert_array_equal(robot.params, np.zeros((2, 10)))
 
 
-GOOD = {"convention": "standard", "joint_types": "RR", "gravity": [0, -9.81, 0],
-        "rows": [{"a": 1, "alpha": 0, "d": 0, "theta": 0}, {"a": 1, "alpha": 0, "d": 0, "theta": 0}]}
+GOOD = {
+    "convention": "standard",
+    "joint_types": "RR",
+    "gravity": [0, -9.81, 0],
+    "rows": [{"a": 1, "alpha": 0, "d": 0, "theta": 0}, {"a": 1, "alpha": 0, "d": 0, "theta": 0}],
+}
 
 
 def _drop(key):
     def change(m):
         del m[key]
+
     return change
 
 
@@ -100,6 +109,7 @@ def _set(*path, value):
         for key in path[:-1]:
             target = target[key]
         target[path[-1]] = value
+
     return change
 
 
@@ -162,8 +172,10 @@ def test_yaml_needs_pyyaml_or_round_trips(tmp_path):
         import yaml  # noqa: F401 -- optional, not a dependency
     except ImportError:
         (tmp_path / "m.yaml").write_text("convention: standard\n")
-        for call in (lambda: load_model(tmp_path / "m.yaml"),
-                     lambda: save_model(robot, tmp_path / "n.yml")):
+        for call in (
+            lambda: load_model(tmp_path / "m.yaml"),
+            lambda: save_model(robot, tmp_path / "n.yml"),
+        ):
             with pytest.raises(ValueError, match="PyYAML, which is not installed"):
                 call()
     else:

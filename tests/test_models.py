@@ -59,17 +59,24 @@ def test_lwr4_joint_limits():
         assert np.degrees(robot.qlim[j]) == pytest.approx([-120.0, 120.0], abs=1e-12)
 
 
-@pytest.mark.parametrize("gravity", [(0.0, -9.81, 0.0), (0.0, 0.0, -9.81)],
-                         ids=["vertical plane", "horizontal plane"])
+@pytest.mark.parametrize(
+    "gravity", [(0.0, -9.81, 0.0), (0.0, 0.0, -9.81)], ids=["vertical plane", "horizontal plane"]
+)
 def test_planar_2r_standard_and_modified_are_the_same_arm(gravity):
-    kwargs = {"l1": 0.8, "l2": 0.6, "lc1": 0.35, "lc2": 0.25, "m1": 2.0, "m2": 1.5,
-              "gravity": gravity}
+    kwargs = {
+        "l1": 0.8,
+        "l2": 0.6,
+        "lc1": 0.35,
+        "lc2": 0.25,
+        "m1": 2.0,
+        "m2": 1.5,
+        "gravity": gravity,
+    }
     standard = dynid.models.planar_2r(convention="standard", **kwargs)
     modified = dynid.models.planar_2r(convention="modified", **kwargs)
     assert (standard.convention, modified.convention) == ("standard", "modified")
     q = np.random.default_rng(7).uniform(-np.pi, np.pi, size=(20, 2))
-    np.testing.assert_allclose(modified.mass_matrix(q), standard.mass_matrix(q), rtol=0,
-                               atol=1e-12)
+    np.testing.assert_allclose(modified.mass_matrix(q), standard.mass_matrix(q), rtol=0, atol=1e-12)
     np.testing.assert_allclose(modified.gravity(q), standard.gravity(q), rtol=0, atol=1e-12)
 
 
@@ -89,10 +96,12 @@ def test_planar_2r_default_matches_the_closed_form_of_the_notes():
             a2 = m2 * l1 * d2
             a3 = i2 + m2 * d2**2
             M = np.array([[a1 + 2 * a2 * c2, a3 + a2 * c2], [a3 + a2 * c2, a3]])
-            g = np.array([
-                g0 * ((m1 * d1 + m2 * l1) * np.cos(q1) + m2 * d2 * np.cos(q1 + q2)),
-                g0 * m2 * d2 * np.cos(q1 + q2),
-            ])
+            g = np.array(
+                [
+                    g0 * ((m1 * d1 + m2 * l1) * np.cos(q1) + m2 * d2 * np.cos(q1 + q2)),
+                    g0 * m2 * d2 * np.cos(q1 + q2),
+                ]
+            )
             np.testing.assert_allclose(robot.mass_matrix([q1, q2]), M, rtol=0, atol=1e-12)
             np.testing.assert_allclose(robot.gravity([q1, q2]), g, rtol=0, atol=1e-12)
 

@@ -41,8 +41,11 @@ def test_panda_parameters_are_the_published_ones() -> None:
         mass, com, inertia = params_to_physical(params)
         assert mass == pytest.approx(row["m"], rel=TOL)
         np.testing.assert_allclose(com, [row["cx"], row["cy"], row["cz"]], rtol=0, atol=TOL)
-        expected = [[row["Ixx"], row["Ixy"], row["Ixz"]], [row["Ixy"], row["Iyy"], row["Iyz"]],
-                    [row["Ixz"], row["Iyz"], row["Izz"]]]
+        expected = [
+            [row["Ixx"], row["Ixy"], row["Ixz"]],
+            [row["Ixy"], row["Iyy"], row["Iyz"]],
+            [row["Ixz"], row["Iyz"], row["Izz"]],
+        ]
         np.testing.assert_allclose(inertia, expected, rtol=0, atol=TOL)
     np.testing.assert_array_equal(robot.Ia, 0.0)
     np.testing.assert_array_equal(robot.Fv, 0.0)
@@ -54,11 +57,16 @@ def _panda_pinocchio(with_gaz_inertias: bool) -> tuple[pin.Model, pin.Data]:
     model = pin.buildReducedModel(full, fingers, pin.neutral(full))
     if with_gaz_inertias:  # joint frames = link frames panda_link1..7
         for jid, row in enumerate(gaz_rows(), start=1):
-            inertia = np.array([[row["Ixx"], row["Ixy"], row["Ixz"]],
-                                [row["Ixy"], row["Iyy"], row["Iyz"]],
-                                [row["Ixz"], row["Iyz"], row["Izz"]]])
-            model.inertias[jid] = pin.Inertia(row["m"], np.array([row["cx"], row["cy"], row["cz"]]),
-                                              inertia)
+            inertia = np.array(
+                [
+                    [row["Ixx"], row["Ixy"], row["Ixz"]],
+                    [row["Ixy"], row["Iyy"], row["Iyz"]],
+                    [row["Ixz"], row["Iyz"], row["Izz"]],
+                ]
+            )
+            model.inertias[jid] = pin.Inertia(
+                row["m"], np.array([row["cx"], row["cy"], row["cz"]]), inertia
+            )
     return model, model.createData()
 
 
@@ -70,9 +78,17 @@ def test_panda_frames_are_the_urdf_link_frames() -> None:
         frame = robot.base.copy()
         for i in range(7):  # modified DH frame i = URDF panda_link{i+1}
             a, alpha, d, theta = robot.dh[i]
-            ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(theta + q[i]), np.sin(theta + q[i])
-            frame = frame @ np.array([[1, 0, 0, a], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1]]) \
+            ca, sa, ct, st = (
+                np.cos(alpha),
+                np.sin(alpha),
+                np.cos(theta + q[i]),
+                np.sin(theta + q[i]),
+            )
+            frame = (
+                frame
+                @ np.array([[1, 0, 0, a], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1]])
                 @ np.array([[ct, -st, 0, 0], [st, ct, 0, 0], [0, 0, 1, d], [0, 0, 0, 1]])
+            )
             urdf_frame = data.oMf[model.getFrameId(f"panda_link{i + 1}")].homogeneous
             assert relative_error(frame, urdf_frame) < TOL
         flange = data.oMf[model.getFrameId("panda_link8")].homogeneous

@@ -37,7 +37,9 @@ T_ON, T_OFF = 0.5, 1.2
 FORCE = np.array([15.0, -10.0, 20.0, 1.0, -2.0, 0.5])  # N, N m at the tool point, world axes
 
 
-def first_order_filter(u_right: np.ndarray, u_left: np.ndarray, gain: np.ndarray, dt: float) -> np.ndarray:
+def first_order_filter(
+    u_right: np.ndarray, u_left: np.ndarray, gain: np.ndarray, dt: float
+) -> np.ndarray:
     """Exact solution of r' = K (u - r), r(0) = 0, for u linear on each step from u_right[k]
     (its value just after t_k) to u_left[k + 1] (just before t_{k+1})."""
     decay = np.exp(-gain * dt)
@@ -150,11 +152,36 @@ def test_the_model_is_copied(contact_run):
         (lambda r: dynid.MomentumObserver(r, np.nan, DT), "gain"),
         (lambda r: dynid.MomentumObserver(r, 10.0, 0.0), "dt"),
         (lambda r: dynid.MomentumObserver(r, 10.0, "1ms"), "dt"),
-        (lambda r: dynid.MomentumObserver(r, 10.0, DT).update(np.zeros(r.n + 1), np.zeros(r.n), np.zeros(r.n)), "q"),
-        (lambda r: dynid.MomentumObserver(r, 10.0, DT).update(np.zeros(r.n), np.zeros(r.n), np.full(r.n, np.inf)), "tau"),
-        (lambda r: dynid.MomentumObserver(r, 10.0, DT).update(np.zeros((2, r.n)), np.zeros((2, r.n)), np.zeros((2, r.n))), "q"),
-        (lambda r: dynid.MomentumObserver(r, 10.0, DT).run(np.zeros(r.n), np.zeros(r.n), np.zeros(r.n)), "q"),
-        (lambda r: dynid.MomentumObserver(r, 10.0, DT).run(np.zeros((3, r.n)), np.zeros((2, r.n)), np.zeros((3, r.n))), "qd"),
+        (
+            lambda r: dynid.MomentumObserver(r, 10.0, DT).update(
+                np.zeros(r.n + 1), np.zeros(r.n), np.zeros(r.n)
+            ),
+            "q",
+        ),
+        (
+            lambda r: dynid.MomentumObserver(r, 10.0, DT).update(
+                np.zeros(r.n), np.zeros(r.n), np.full(r.n, np.inf)
+            ),
+            "tau",
+        ),
+        (
+            lambda r: dynid.MomentumObserver(r, 10.0, DT).update(
+                np.zeros((2, r.n)), np.zeros((2, r.n)), np.zeros((2, r.n))
+            ),
+            "q",
+        ),
+        (
+            lambda r: dynid.MomentumObserver(r, 10.0, DT).run(
+                np.zeros(r.n), np.zeros(r.n), np.zeros(r.n)
+            ),
+            "q",
+        ),
+        (
+            lambda r: dynid.MomentumObserver(r, 10.0, DT).run(
+                np.zeros((3, r.n)), np.zeros((2, r.n)), np.zeros((3, r.n))
+            ),
+            "qd",
+        ),
     ],
 )
 def test_bad_input_raises_value_error_naming_argument(call, name):
@@ -165,6 +192,7 @@ def test_bad_input_raises_value_error_naming_argument(call, name):
 
 # ----------------------------------------------------------------------------- real data
 
+
 def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property, tmp_path):
     from dynid.io import load_log
     from dynid.io.result_files import load_result, save_result
@@ -174,13 +202,15 @@ def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property, tmp
     data = REPO / "tests" / "data"
     train = load_log(data / "measurements_1.npz", skip=500)
     check = load_log(data / "measurements_2.npz", skip=500)
-    result = identify_log(train, dynid.models.kuka_lwr4(), rotor=True, friction=True,
-                          offset=True, method="wls")
+    result = identify_log(
+        train, dynid.models.kuka_lwr4(), rotor=True, friction=True, offset=True, method="wls"
+    )
     robot, offsets = robot_from_identification(result)
     # the equivalent robot reproduces the identified model's prediction (regressor route)
     predicted = result.predict(check)
-    np.testing.assert_allclose(robot.rnea(check.q, check.qd, check.qdd) + offsets, predicted,
-                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        robot.rnea(check.q, check.qd, check.qdd) + offsets, predicted, rtol=0, atol=1e-9
+    )
     gain = 20.0
     residual = residual_from_log(result, check, gain)
     assert residual.r.shape == check.q.shape
@@ -221,6 +251,7 @@ def test_residual_files_and_plot(tmp_path, contact_run):
 
 # ----------------------------------------------------------------------------- real time
 
+
 def test_no_heap_allocation_per_update(tmp_path):
     """Compiles tests/cpp/test_uses_no_allocation.cpp with the core's sources and runs it: it
     counts every operator new and malloc during 10^4 observer updates, rnea_derivatives and
@@ -232,10 +263,23 @@ def test_no_heap_allocation_per_update(tmp_path):
     program = tmp_path / "test_uses_no_allocation"
     sources = sorted(str(p) for p in (REPO / "cpp" / "src").glob("*.cpp"))
     build = subprocess.run(
-        [compiler, "-O1", "-DNDEBUG", "-std=c++17", f"-I{REPO / 'cpp' / 'include'}",
-         f"-I{REPO / 'cpp' / 'examples'}", f"-I{find_eigen()}",
-         str(REPO / "tests" / "cpp" / "test_uses_no_allocation.cpp"), *sources, "-o", str(program)],
-        check=False, capture_output=True, text=True, timeout=900,
+        [
+            compiler,
+            "-O1",
+            "-DNDEBUG",
+            "-std=c++17",
+            f"-I{REPO / 'cpp' / 'include'}",
+            f"-I{REPO / 'cpp' / 'examples'}",
+            f"-I{find_eigen()}",
+            str(REPO / "tests" / "cpp" / "test_uses_no_allocation.cpp"),
+            *sources,
+            "-o",
+            str(program),
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=900,
     )
     assert build.returncode == 0, build.stderr
     run = subprocess.run([str(program)], check=False, capture_output=True, text=True, timeout=300)

@@ -20,7 +20,9 @@ from conftest import ARM_CASES, make_arm, random_state
 
 
 def assert_close(actual, expected, rtol):
-    np.testing.assert_allclose(actual, expected, rtol=0, atol=rtol * max(1.0, np.abs(expected).max()))
+    np.testing.assert_allclose(
+        actual, expected, rtol=0, atol=rtol * max(1.0, np.abs(expected).max())
+    )
 
 
 @pytest.mark.parametrize("case", ARM_CASES)
@@ -57,7 +59,9 @@ def test_puma_matches_the_square_jacobian_formulas():
         J_inv = np.linalg.inv(J)
         M = robot.mass_matrix(q)
         Lam_expected = J_inv.T @ M @ J_inv
-        mu_expected = J_inv.T @ robot.coriolis(q, qd) - Lam_expected @ robot.jacobian_dot(q, qd) @ qd
+        mu_expected = (
+            J_inv.T @ robot.coriolis(q, qd) - Lam_expected @ robot.jacobian_dot(q, qd) @ qd
+        )
         p_expected = J_inv.T @ robot.gravity(q)
         assert_close(robot.cartesian_inertia(q), Lam_expected, 1e-9)
         Lam, mu, p = robot.cartesian_dynamics(q, qd)
@@ -68,8 +72,15 @@ def test_puma_matches_the_square_jacobian_formulas():
 
 @pytest.mark.parametrize(
     ("robot_name", "rows"),
-    [("puma", None), ("lwr", None), ("lwr", "position"), ("lwr", "orientation"),
-     ("prismatic_first", "position"), ("prismatic_first", (0, 2, 4)), ("planar", (0, 1))],
+    [
+        ("puma", None),
+        ("lwr", None),
+        ("lwr", "position"),
+        ("lwr", "orientation"),
+        ("prismatic_first", "position"),
+        ("prismatic_first", (0, 2, 4)),
+        ("planar", (0, 1)),
+    ],
 )
 def test_operational_space_equation_matches_forward_dynamics(robot_name, rows):
     rng = np.random.default_rng(12)

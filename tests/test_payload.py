@@ -56,8 +56,15 @@ def tool_at(robot: dynid.Robot, com: np.ndarray) -> dynid.Robot:
     """The same arm with its tool frame at the payload's centre of mass (frame n axes)."""
     tool = np.eye(4)
     tool[:3, 3] = com
-    return dynid.Robot.from_dh(robot.dh, robot.joint_types, robot.convention,
-                               robot.gravity_vector, robot.params, robot.base, tool)
+    return dynid.Robot.from_dh(
+        robot.dh,
+        robot.joint_types,
+        robot.convention,
+        robot.gravity_vector,
+        robot.params,
+        robot.base,
+        tool,
+    )
 
 
 @pytest.fixture(params=sorted(PAYLOADS))
@@ -76,8 +83,9 @@ def test_with_payload_changes_only_the_last_link_by_the_rule_of_change(payload):
     loaded = robot.with_payload(mass, com, inertia)
     np.testing.assert_array_equal(robot.params, before)
     np.testing.assert_array_equal(loaded.params[:-1], before[:-1])
-    np.testing.assert_allclose(loaded.params[-1], combined_link(before[-1], mass, com, inertia),
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        loaded.params[-1], combined_link(before[-1], mass, com, inertia), rtol=0, atol=1e-12
+    )
     for field in ("Ia", "Fv", "Fs", "dh", "base", "tool", "qlim", "gravity_vector"):
         np.testing.assert_array_equal(getattr(loaded, field), getattr(robot, field), field)
     assert loaded.is_physically_consistent()
@@ -91,9 +99,14 @@ def test_with_payload_gravity_and_mass_matrix_add_the_payloads_own(payload):
     I_L = np.zeros((3, 3)) if inertia is None else inertia
     robot = dynid.models.kuka_lwr4()
     loaded = robot.with_payload(mass, com, inertia)
-    arm = ref.Arm(dh=np.array(robot.dh), joint_types=robot.joint_types,
-                  convention=robot.convention, mass=np.ones(7), com=np.zeros((7, 3)),
-                  inertia_com=np.zeros((7, 3, 3)))
+    arm = ref.Arm(
+        dh=np.array(robot.dh),
+        joint_types=robot.joint_types,
+        convention=robot.convention,
+        mass=np.ones(7),
+        com=np.zeros((7, 3)),
+        inertia_com=np.zeros((7, 3, 3)),
+    )
     g0 = np.array(robot.gravity_vector)
     tool = tool_at(robot, com)
     for q in robot.random_configurations(6, seed=1):
@@ -105,10 +118,12 @@ def test_with_payload_gravity_and_mass_matrix_add_the_payloads_own(payload):
         g_L = -mass * J[:3].T @ g0
         M_L = mass * J[:3].T @ J[:3] + J[3:].T @ R @ I_L @ R.T @ J[3:]
         g_new, M_new = loaded.gravity(q), loaded.mass_matrix(q)
-        np.testing.assert_allclose(g_new, robot.gravity(q) + g_L, rtol=0,
-                                   atol=1e-10 * np.abs(g_new).max())
-        np.testing.assert_allclose(M_new, robot.mass_matrix(q) + M_L, rtol=0,
-                                   atol=1e-10 * np.abs(M_new).max())
+        np.testing.assert_allclose(
+            g_new, robot.gravity(q) + g_L, rtol=0, atol=1e-10 * np.abs(g_new).max()
+        )
+        np.testing.assert_allclose(
+            M_new, robot.mass_matrix(q) + M_L, rtol=0, atol=1e-10 * np.abs(M_new).max()
+        )
 
 
 def test_with_payload_potential_energy_gradient_is_the_added_gravity(payload):
@@ -122,11 +137,18 @@ def test_with_payload_potential_energy_gradient_is_the_added_gravity(payload):
     for q in robot.random_configurations(4, seed=2):
         added = loaded.potential_energy(q) - robot.potential_energy(q)
         assert added == pytest.approx(-mass * g0 @ tool.fkine(q)[:3, 3], abs=1e-12)
-        gradient = np.array([
-            (loaded.potential_energy(q + h * e) - robot.potential_energy(q + h * e)
-             - loaded.potential_energy(q - h * e) + robot.potential_energy(q - h * e)) / (2 * h)
-            for e in np.eye(robot.n)
-        ])
+        gradient = np.array(
+            [
+                (
+                    loaded.potential_energy(q + h * e)
+                    - robot.potential_energy(q + h * e)
+                    - loaded.potential_energy(q - h * e)
+                    + robot.potential_energy(q - h * e)
+                )
+                / (2 * h)
+                for e in np.eye(robot.n)
+            ]
+        )
         dg = loaded.gravity(q) - robot.gravity(q)
         np.testing.assert_allclose(gradient, dg, rtol=0, atol=1e-7 * np.abs(dg).max())
 
@@ -185,12 +207,14 @@ def with_flange_offset() -> dynid.Robot:
     robot = controller_model()
     dh = np.array(robot.dh)
     dh[6, 2] = 0.078
-    return dynid.Robot.from_dh(dh, robot.joint_types, robot.convention, robot.gravity_vector,
-                               robot.params, qlim=robot.qlim)
+    return dynid.Robot.from_dh(
+        dh, robot.joint_types, robot.convention, robot.gravity_vector, robot.params, qlim=robot.qlim
+    )
 
 
-@pytest.mark.parametrize("make", [controller_model, with_flange_offset],
-                         ids=["paper_frames", "flange_in_dh"])
+@pytest.mark.parametrize(
+    "make", [controller_model, with_flange_offset], ids=["paper_frames", "flange_in_dh"]
+)
 def test_exactly_the_d1_and_d2_coefficients_carry_the_payload_mass(make):
     # Independent derivation: evaluate the gravity expressions (text) on the robot with two very
     # different payloads of the same mass; a coefficient that changes by the same k * m_L for
@@ -202,8 +226,11 @@ def test_exactly_the_d1_and_d2_coefficients_carry_the_payload_mass(make):
     mass = 0.7
     probes = (((0.04, -0.03, 0.2), None), ((-0.1, 0.05, -0.02), np.diag([1e-3, 2e-3, 2.5e-3])))
     changes = [
-        (evaluate(base.expressions, robot.with_payload(mass, com, inertia))
-         - evaluate(base.expressions, robot)) / mass
+        (
+            evaluate(base.expressions, robot.with_payload(mass, com, inertia))
+            - evaluate(base.expressions, robot)
+        )
+        / mass
         for com, inertia in probes
     ]
     same = np.abs(changes[0] - changes[1]) < 1e-12

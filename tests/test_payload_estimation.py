@@ -19,8 +19,11 @@ from dynid.sim import VirtualController
 
 EXACT = 1e-9  # noise-free data: the fit is exact up to rounding (observed ~1e-15)
 PAYLOADS = {
-    "offset_body": (0.8, np.array([0.03, -0.02, 0.09]),
-                    np.array([[2e-3, 1e-4, -2e-4], [1e-4, 1.5e-3, 3e-4], [-2e-4, 3e-4, 1e-3]])),
+    "offset_body": (
+        0.8,
+        np.array([0.03, -0.02, 0.09]),
+        np.array([[2e-3, 1e-4, -2e-4], [1e-4, 1.5e-3, 3e-4], [-2e-4, 3e-4, 1e-3]]),
+    ),
     "demo_tip": (TIP_MASS, np.array(TIP_COM), np.array(TIP_INERTIA)),
     "heavy_box": (5.0, np.array([-0.05, 0.08, 0.15]), np.diag([0.02, 0.03, 0.025])),
 }
@@ -68,8 +71,12 @@ def test_noise_free_fourier_trajectory_with_identified_unloaded_model():
     Y0 = base.reduce(robot.regressor(q0, qd0, qdd0, rotor=True, friction=True))
     beta = dynid.least_squares(Y0, robot.rnea(q0, qd0, qdd0)).theta
     rng = np.random.default_rng(3)
-    trajectory = dynid.FourierTrajectory(2 * np.pi * 0.1, 0.3 * rng.standard_normal((7, 5)),
-                                         0.3 * rng.standard_normal((7, 5)), np.zeros(7))
+    trajectory = dynid.FourierTrajectory(
+        2 * np.pi * 0.1,
+        0.3 * rng.standard_normal((7, 5)),
+        0.3 * rng.standard_normal((7, 5)),
+        np.zeros(7),
+    )
     _, q, qd, qdd = trajectory.sample(fs=50.0)
     tau = robot.with_payload(mass, com, inertia).rnea(q, qd, qdd)
     predicted = base.reduce(robot.regressor(q, qd, qdd, rotor=True, friction=True)) @ beta
@@ -86,11 +93,19 @@ def test_tool_frame_results_are_the_flange_results_moved():
     arm = dynid.models.kuka_lwr4()
     cz, sz, cx, sx = np.cos(0.7), np.sin(0.7), np.cos(-0.4), np.sin(-0.4)
     R = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]]) @ np.array(
-        [[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+        [[1, 0, 0], [0, cx, -sx], [0, sx, cx]]
+    )
     tool = np.eye(4)
     tool[:3, :3], tool[:3, 3] = R, (0.01, -0.02, 0.12)
-    robot = dynid.Robot.from_dh(arm.dh, arm.joint_types, arm.convention, arm.gravity_vector,
-                                arm.params, tool=tool, qlim=arm.qlim)
+    robot = dynid.Robot.from_dh(
+        arm.dh,
+        arm.joint_types,
+        arm.convention,
+        arm.gravity_vector,
+        arm.params,
+        tool=tool,
+        qlim=arm.qlim,
+    )
     q, qd, qdd = random_states(robot, 300, seed=5)
     tau = robot.with_payload(mass, com, inertia).rnea(q, qd, qdd)
     rng = np.random.default_rng(0)
@@ -101,8 +116,9 @@ def test_tool_frame_results_are_the_flange_results_moved():
     np.testing.assert_allclose(est.com, R.T @ (flange.com - tool[:3, 3]), rtol=0, atol=1e-12)
     np.testing.assert_allclose(est.inertia, R.T @ flange.inertia @ R, rtol=0, atol=1e-12)
     # Noise-free: the truth in the tool frame.
-    exact = estimate_payload(robot, q, qd, qdd, robot.with_payload(mass, com, inertia).rnea(
-        q, qd, qdd), frame="tool")
+    exact = estimate_payload(
+        robot, q, qd, qdd, robot.with_payload(mass, com, inertia).rnea(q, qd, qdd), frame="tool"
+    )
     np.testing.assert_allclose(exact.com, R.T @ (com - tool[:3, 3]), rtol=0, atol=EXACT)
     np.testing.assert_allclose(exact.inertia, R.T @ inertia @ R, rtol=0, atol=EXACT)
     # The com std from R^T Cov R, with Cov_c recomputed from the fit by the delta method.
@@ -119,13 +135,20 @@ def test_delta_method_jacobian_matches_finite_differences():
     theta = np.concatenate([[mass], mass * com, steiner[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]])
     phi, G = physical_from_parameters(theta)
     np.testing.assert_allclose(phi[1:4], com, rtol=0, atol=1e-15)
-    np.testing.assert_allclose(phi[4:], inertia[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]],
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        phi[4:], inertia[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]], rtol=0, atol=1e-15
+    )
     step = 1e-6
-    numeric = np.column_stack([
-        (physical_from_parameters(theta + step * e)[0] - physical_from_parameters(
-            theta - step * e)[0]) / (2 * step) for e in np.eye(10)
-    ])
+    numeric = np.column_stack(
+        [
+            (
+                physical_from_parameters(theta + step * e)[0]
+                - physical_from_parameters(theta - step * e)[0]
+            )
+            / (2 * step)
+            for e in np.eye(10)
+        ]
+    )
     np.testing.assert_allclose(G, numeric, rtol=0, atol=1e-8 * np.abs(G).max())
     _, G4 = physical_from_parameters(theta[:4])
     np.testing.assert_allclose(G4, G[:4, :4], rtol=0, atol=0)
@@ -148,9 +171,15 @@ def test_noisy_estimates_lie_within_three_std_and_the_std_are_calibrated():
         rng = np.random.default_rng(seed)
         tau = loaded.rnea(q, qd, qdd) + NOISE * rng.standard_normal(q.shape)
         est = estimate_payload(robot, q, qd, qdd, tau)
-        z.append(np.concatenate([[(est.mass - mass) / est.mass_std],
-                                 (est.com - com) / est.com_std,
-                                 ((est.inertia - inertia) / est.inertia_std)[np.triu_indices(3)]]))
+        z.append(
+            np.concatenate(
+                [
+                    [(est.mass - mass) / est.mass_std],
+                    (est.com - com) / est.com_std,
+                    ((est.inertia - inertia) / est.inertia_std)[np.triu_indices(3)],
+                ]
+            )
+        )
     z = np.array(z)
     assert np.abs(z[0]).max() < 3.0
     assert np.abs(z).max() < 4.5
@@ -167,7 +196,8 @@ def test_weighted_least_squares_with_joints_of_different_noise():
     rng = np.random.default_rng(21)
     level = np.array([0.01] * 4 + [0.2] * 3)
     tau = robot.with_payload(mass, com, inertia).rnea(q, qd, qdd) + level * rng.standard_normal(
-        q.shape)
+        q.shape
+    )
     wls = estimate_payload(robot, q, qd, qdd, tau, method="wls")
     ols = estimate_payload(robot, q, qd, qdd, tau)
     assert abs(wls.mass - mass) < 3 * wls.mass_std
@@ -185,8 +215,9 @@ def test_no_payload_gives_zero_and_no_centre_of_mass():
     est = estimate_payload(robot, q, qd, qdd, tau)
     np.testing.assert_allclose(est.parameters, 0.0, rtol=0, atol=1e-12)
     assert est.com is None and est.inertia is None and est.com_std is None
-    noisy = estimate_payload(robot, q, qd, qdd,
-                             tau + NOISE * np.random.default_rng(1).standard_normal(tau.shape))
+    noisy = estimate_payload(
+        robot, q, qd, qdd, tau + NOISE * np.random.default_rng(1).standard_normal(tau.shape)
+    )
     assert abs(noisy.mass) < 3 * noisy.mass_std and noisy.com is None
 
 
@@ -211,8 +242,9 @@ def test_a_planar_arm_cannot_see_the_out_of_plane_parameters():
     robot = dynid.models.planar_2r()
     q, qd, qdd = random_states(robot, 200, seed=2)
     tau = robot.with_payload(0.5, (0.1, 0.02, 0.0), np.diag([1e-3, 2e-3, 2e-3])).rnea(q, qd, qdd)
-    with pytest.raises(dynid.RankDeficientError,
-                       match=r"^the data do not determine the payload: .*rank 4 < 10") as info:
+    with pytest.raises(
+        dynid.RankDeficientError, match=r"^the data do not determine the payload: .*rank 4 < 10"
+    ) as info:
         estimate_payload(robot, q, qd, qdd, tau)
     least = str(info.value).split("least excited: ")[1].split(" (")[0].split(", ")
     assert set(least) <= {"mz_L", "Ixx_L", "Ixy_L", "Ixz_L", "Iyy_L", "Iyz_L"}
@@ -223,7 +255,9 @@ def test_too_few_samples_is_a_clear_error():
     # One sample of 7 joints: 7 equations for 10 unknowns.
     robot = dynid.models.kuka_lwr4()
     q = np.full(7, 0.3)
-    with pytest.raises(dynid.RankDeficientError, match=r"^q: 1 sample\(s\) give 7 torque equations"):
+    with pytest.raises(
+        dynid.RankDeficientError, match=r"^q: 1 sample\(s\) give 7 torque equations"
+    ):
         estimate_payload(robot, q, q, q, robot.rnea(q, q, q))
 
 
@@ -268,9 +302,16 @@ def test_the_mass_equals_the_papers_eqs_31_32_on_the_papers_setting(noise):
     assert sorted(e["factor"] for e in paper) == [0.39, 0.4]
     loaded = readings[1]
     zero = np.zeros_like(loaded.q)
-    est = estimate_payload(structure, loaded.q, zero, zero, loaded.g,
-                           tau_unloaded=fits[0].gravity(loaded.q), inertia=False,
-                           exclude_joints=(0,))
+    est = estimate_payload(
+        structure,
+        loaded.q,
+        zero,
+        zero,
+        loaded.g,
+        tau_unloaded=fits[0].gravity(loaded.q),
+        inertia=False,
+        exclude_joints=(0,),
+    )
     if noise == 0.0:
         assert est.mass == pytest.approx(TIP_MASS, abs=EXACT)
         np.testing.assert_allclose(est.com, TIP_COM, rtol=0, atol=EXACT)
@@ -304,8 +345,14 @@ def test_bad_arguments_are_value_errors_naming_them(change, match):
     q, qd, qdd = random_states(robot, 10, seed=0)
     args = {"robot": robot, "q": q, "qd": qd, "qdd": qdd, "tau": robot.rnea(q, qd, qdd), **change}
     with pytest.raises(ValueError, match=match):
-        estimate_payload(args.pop("robot"), args.pop("q"), args.pop("qd"), args.pop("qdd"),
-                         args.pop("tau"), **args)
+        estimate_payload(
+            args.pop("robot"),
+            args.pop("q"),
+            args.pop("qd"),
+            args.pop("qdd"),
+            args.pop("tau"),
+            **args,
+        )
 
 
 def test_results_compare_by_value():
@@ -328,8 +375,9 @@ def identified_pair(payload, noise: float, structure=None, truth=None, **options
     truth = truth or controller_model()
     fits = []
     for k, robot in enumerate((truth, truth.with_payload(*payload))):
-        controller = VirtualController(robot, seed=k, model_noise=1e-5 * noise,
-                                       position_noise=1e-5 * noise)
+        controller = VirtualController(
+            robot, seed=k, model_noise=1e-5 * noise, position_noise=1e-5 * noise
+        )
         data = controller.read_static(controller.random_configurations(1000))
         fits.append(dynid.identify_from_controller(structure, data.q, data.g, data.M, **options))
     return fits
@@ -372,9 +420,11 @@ def test_coefficient_changes_of_a_planar_arm_name_what_they_miss():
     robot = dynid.models.planar_2r()
     payload = (0.5, np.array([0.1, 0.02, 0.0]), np.diag([1e-3, 2e-3, 2e-3]))
     fits = identified_pair(payload, 0.0, structure=robot, truth=robot, exclude_gravity_joints=())
-    with pytest.raises(dynid.RankDeficientError,
-                       match=r"^the coefficient changes do not determine the payload: rank 4 < 10"
-                             r"; not determined: mz_L, Ixx_L, Ixy_L, Ixz_L, Iyy_L, Iyz_L$"):
+    with pytest.raises(
+        dynid.RankDeficientError,
+        match=r"^the coefficient changes do not determine the payload: rank 4 < 10"
+        r"; not determined: mz_L, Ixx_L, Ixy_L, Ixz_L, Iyy_L, Iyz_L$",
+    ):
         dynid.payload_from_identified(*fits)
 
 
@@ -385,8 +435,9 @@ def test_payload_from_identified_bad_arguments():
     with pytest.raises(ValueError, match=r"^frame: expected one of"):
         dynid.payload_from_identified(unloaded, loaded, frame="base")
     robot = dynid.models.planar_2r()
-    other = identified_pair(PAYLOADS["demo_tip"], 0.0, structure=robot, truth=robot,
-                            exclude_gravity_joints=())[1]
+    other = identified_pair(
+        PAYLOADS["demo_tip"], 0.0, structure=robot, truth=robot, exclude_gravity_joints=()
+    )[1]
     with pytest.raises(ValueError, match=r"^loaded: identified on another structure"):
         dynid.payload_from_identified(unloaded, other)
 
@@ -397,8 +448,9 @@ def test_as_dict_is_json_ready():
 
     robot = dynid.models.kuka_lwr4()
     q, qd, qdd = random_states(robot, 50, seed=0)
-    est = estimate_payload(robot, q, qd, qdd,
-                           robot.with_payload(*PAYLOADS["offset_body"]).rnea(q, qd, qdd))
+    est = estimate_payload(
+        robot, q, qd, qdd, robot.with_payload(*PAYLOADS["offset_body"]).rnea(q, qd, qdd)
+    )
     back = json.loads(json.dumps(est.as_dict()))
     assert back["mass"] == est.mass and back["frame"] == "flange"
     np.testing.assert_array_equal(back["com"], est.com)

@@ -66,17 +66,26 @@ def test_pseudo_inertia_of_a_box_is_its_second_moment():
     """Uniform box, sides (a, b, c), mass m, centre at r, axes of frame i: integral of r r^T dm
     = m (diag(a^2, b^2, c^2) / 12 + r r^T), first moment m r (closed forms); exact to 1e-15."""
     m, sides, r = 2.5, np.array([0.3, 0.1, 0.05]), np.array([0.1, -0.2, 0.05])
-    inertia_com = m / 12 * np.diag([sides[1] ** 2 + sides[2] ** 2, sides[0] ** 2 + sides[2] ** 2,
-                                    sides[0] ** 2 + sides[1] ** 2])
+    inertia_com = (
+        m
+        / 12
+        * np.diag(
+            [
+                sides[1] ** 2 + sides[2] ** 2,
+                sides[0] ** 2 + sides[2] ** 2,
+                sides[0] ** 2 + sides[1] ** 2,
+            ]
+        )
+    )
     robot = dynid.Robot.from_dh([[0, 0, 0, 0]])
     robot.set_link(0, m, r, inertia_com)
     J = pseudo_inertia(robot.params[0])
-    np.testing.assert_allclose(J[:3, :3], m * (np.diag(sides**2) / 12 + np.outer(r, r)),
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        J[:3, :3], m * (np.diag(sides**2) / 12 + np.outer(r, r)), rtol=0, atol=1e-15
+    )
     np.testing.assert_allclose(J[:3, 3], m * r, rtol=0, atol=1e-15)
     assert J[3, 3] == m
-    np.testing.assert_allclose(standard_from_pseudo_inertia(J), robot.params[0], rtol=0,
-                               atol=1e-15)
+    np.testing.assert_allclose(standard_from_pseudo_inertia(J), robot.params[0], rtol=0, atol=1e-15)
 
 
 def test_positive_definite_pseudo_inertia_is_physical_consistency():
@@ -142,8 +151,9 @@ def test_prior_equal_to_the_truth_gives_the_full_standard_parameters(lwr, data):
     """With the truth as prior, the 91 - 62 directions the data cannot see come back too: every
     standard parameter to 1e-6 of the largest."""
     Y, tau = data
-    fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True, prior=lwr,
-                                 prior_weight=1e-4)
+    fit = physical_least_squares(
+        lwr, Y, tau, rotor=True, friction=True, prior=lwr, prior_weight=1e-4
+    )
     truth = lwr.parameter_vector(True, True)
     np.testing.assert_allclose(fit.theta, truth, rtol=0, atol=1e-6 * np.abs(truth).max())
 
@@ -154,26 +164,29 @@ def test_the_unseen_directions_come_from_the_prior(lwr, base, data):
     prior is 0), not the truth; to 1e-6 of the largest parameter."""
     Y, tau = data
     truth = lwr.parameter_vector(True, True)
-    null = np.linalg.svd(base.beta)[2][base.count:].T  # (P, P - p)
+    null = np.linalg.svd(base.beta)[2][base.count :].T  # (P, P - p)
     delta = null @ np.random.default_rng(7).normal(size=null.shape[1])
-    delta[10 * lwr.n:] = 0.0
+    delta[10 * lwr.n :] = 0.0
     delta = null @ np.linalg.lstsq(null, delta, rcond=None)[0]  # back in the null space
     prior = lwr.copy()
     scale = 0.02 / np.abs(delta).max()
     while True:  # the largest change (halving from 0.02) that keeps the prior consistent
-        prior.params = (truth + scale * delta)[:10 * lwr.n].reshape(lwr.n, 10)
-        prior.Ia, prior.Fv, prior.Fs = (truth + scale * delta)[10 * lwr.n:].reshape(3, lwr.n)
+        prior.params = (truth + scale * delta)[: 10 * lwr.n].reshape(lwr.n, 10)
+        prior.Ia, prior.Fv, prior.Fs = (truth + scale * delta)[10 * lwr.n :].reshape(3, lwr.n)
         if prior.is_physically_consistent() and min(prior.Ia.min(), prior.Fv.min()) > 0:
             break
         scale /= 2
     assert np.abs(base.beta @ (scale * delta)).max() < 1e-14
     assert np.abs(scale * delta).max() > 1e-3  # a visible change of the standard parameters
-    fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True, prior=prior,
-                                 prior_weight=1e-3)
-    np.testing.assert_allclose(fit.theta, prior.parameter_vector(True, True), rtol=0,
-                               atol=1e-6 * np.abs(truth).max())
-    np.testing.assert_allclose(fit.base_values, base.values(lwr), rtol=0,
-                               atol=1e-6 * np.abs(truth).max())
+    fit = physical_least_squares(
+        lwr, Y, tau, rotor=True, friction=True, prior=prior, prior_weight=1e-3
+    )
+    np.testing.assert_allclose(
+        fit.theta, prior.parameter_vector(True, True), rtol=0, atol=1e-6 * np.abs(truth).max()
+    )
+    np.testing.assert_allclose(
+        fit.base_values, base.values(lwr), rtol=0, atol=1e-6 * np.abs(truth).max()
+    )
 
 
 def test_offsets_as_extra_columns_are_recovered(lwr, base, data):
@@ -182,8 +195,14 @@ def test_offsets_as_extra_columns_are_recovered(lwr, base, data):
     Y, tau = data
     offsets = np.array([0.8, -0.9, 0.1, 0.2, -0.5, 0.3, -0.3])
     ones = np.broadcast_to(np.eye(lwr.n), (Y.shape[0], lwr.n, lwr.n))
-    fit = physical_least_squares(lwr, np.concatenate([Y, ones], axis=2), tau + offsets,
-                                 rotor=True, friction=True, extra_columns=lwr.n)
+    fit = physical_least_squares(
+        lwr,
+        np.concatenate([Y, ones], axis=2),
+        tau + offsets,
+        rotor=True,
+        friction=True,
+        extra_columns=lwr.n,
+    )
     np.testing.assert_allclose(fit.extra, offsets, rtol=0, atol=1e-7)
     true = base.values(lwr)
     np.testing.assert_allclose(fit.base_values, true, rtol=1e-6, atol=1e-9 * np.abs(true).max())
@@ -207,7 +226,8 @@ def inconsistent(lwr):
 
 
 def test_data_of_an_impossible_robot_give_a_consistent_robot_and_a_larger_residual(
-        lwr, base, inconsistent):
+    lwr, base, inconsistent
+):
     """Unconstrained LS fits these data exactly with inconsistent values; the SDP returns a
     consistent robot whose residual is at least the LS residual (it is optimal over a smaller
     set), and whose Ia, Fv are on their bounds where the truth is negative (active
@@ -240,8 +260,8 @@ def test_no_feasible_step_improves_the_optimum(lwr, inconsistent):
         y = np.empty_like(fit.theta)
         for i in range(lwr.n):
             L = rng.normal(0, 0.3, (4, 4))
-            y[10 * i:10 * i + 10] = standard_from_pseudo_inertia(L @ L.T + 1e-3 * np.eye(4))
-        y[10 * lwr.n:] = rng.uniform(0, 2, 3 * lwr.n)
+            y[10 * i : 10 * i + 10] = standard_from_pseudo_inertia(L @ L.T + 1e-3 * np.eye(4))
+        y[10 * lwr.n :] = rng.uniform(0, 2, 3 * lwr.n)
         for step in (1e-3, 1e-2, 0.1):
             assert sse(fit.theta + step * (y - fit.theta)) >= best * (1 - 1e-9)
 
@@ -260,21 +280,28 @@ def test_mass_bounds_and_total_mass_are_respected(lwr, base, data):
     fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True, mass_bounds=bounds)
     masses = fit.params[:, 0]
     assert np.all(masses >= bounds[:, 0] - 1e-7) and np.all(masses <= bounds[:, 1] + 1e-7)
-    total = physical_least_squares(lwr, Y, tau, rotor=True, friction=True,
-                                   total_mass=1.1 * m.sum())
+    total = physical_least_squares(lwr, Y, tau, rotor=True, friction=True, total_mass=1.1 * m.sum())
     assert abs(total.params[:, 0].sum() - 1.1 * m.sum()) < 1e-7
     true = base.values(lwr)
     for estimate in (fit, total):
-        np.testing.assert_allclose(estimate.base_values, true, rtol=1e-6,
-                                   atol=1e-7 * np.abs(true).max())
+        np.testing.assert_allclose(
+            estimate.base_values, true, rtol=1e-6, atol=1e-7 * np.abs(true).max()
+        )
 
 
 def test_infeasible_bounds_raise_with_the_solver_status(lwr, data):
     """Every link at most 1 kg but 100 kg in total: no model, an error naming the status."""
     Y, tau = data
     with pytest.raises(PhysicalIdentificationError, match="infeasible") as info:
-        physical_least_squares(lwr, Y, tau, rotor=True, friction=True,
-                               mass_bounds=np.tile([0.0, 1.0], (lwr.n, 1)), total_mass=100.0)
+        physical_least_squares(
+            lwr,
+            Y,
+            tau,
+            rotor=True,
+            friction=True,
+            mass_bounds=np.tile([0.0, 1.0], (lwr.n, 1)),
+            total_mass=100.0,
+        )
     assert info.value.status == "infeasible"
 
 
@@ -289,8 +316,9 @@ def test_the_result_robot_is_usable(exact, data, lwr):
     q, qd, qdd = states(lwr, 500, seed=21)
     tau_robot = robot.rnea(q, qd, qdd)
     Y500 = lwr.regressor(q, qd, qdd, rotor=True, friction=True)
-    np.testing.assert_allclose(tau_robot, Y500 @ exact.theta, rtol=0,
-                               atol=1e-9 * np.abs(tau_robot).max())
+    np.testing.assert_allclose(
+        tau_robot, Y500 @ exact.theta, rtol=0, atol=1e-9 * np.abs(tau_robot).max()
+    )
     np.testing.assert_allclose(robot.forward_dynamics(q, qd, tau_robot), qdd, rtol=0, atol=1e-8)
     M = robot.mass_matrix(q)
     np.linalg.cholesky(M)  # raises LinAlgError unless positive definite
@@ -309,8 +337,9 @@ def test_terms_not_estimated_are_zero_in_the_result(lwr):
     fit = physical_least_squares(lwr, lwr.regressor(q, qd, qdd), tau)
     assert fit.Ia is None and fit.Fv is None and fit.Fs is None
     assert not fit.robot.Ia.any() and not fit.robot.Fv.any() and not fit.robot.Fs.any()
-    np.testing.assert_allclose(fit.robot.rnea(q, qd, qdd), tau, rtol=0,
-                               atol=1e-7 * np.abs(tau).max())
+    np.testing.assert_allclose(
+        fit.robot.rnea(q, qd, qdd), tau, rtol=0, atol=1e-7 * np.abs(tau).max()
+    )
 
 
 def test_result_pickles_copies_and_compares(exact):
@@ -331,8 +360,7 @@ def test_stacked_rows_and_per_row_weights_are_the_same_problem(lwr, data, exact)
     solver's tolerance (1e-6 of the largest base value)."""
     Y, tau = data
     P = Y.shape[2]
-    flat = physical_least_squares(lwr, Y.reshape(-1, P), tau.reshape(-1), rotor=True,
-                                  friction=True)
+    flat = physical_least_squares(lwr, Y.reshape(-1, P), tau.reshape(-1), rotor=True, friction=True)
     scale = 1e-6 * np.abs(exact.base_values).max()
     np.testing.assert_allclose(flat.base_values, exact.base_values, rtol=0, atol=scale)
     for weights in (np.full(lwr.n, 7.0), np.full(tau.shape, 7.0), np.full(tau.size, 7.0)):
@@ -364,39 +392,42 @@ def _call(lwr, data, **changes):
     return physical_least_squares(**kwargs)
 
 
-@pytest.mark.parametrize(("changes", "name"), [
-    ({"robot": "kuka"}, "robot"),
-    ({"Y": np.zeros((10, 7, 5))}, "Y"),
-    ({"Y": np.zeros((10, 5, 91))}, "Y"),
-    ({"Y": np.zeros((13, 91))}, "Y"),
-    ({"Y": np.zeros(91)}, "Y"),
-    ({"Y": "text"}, "Y"),
-    ({"tau": np.zeros((3, 7))}, "tau"),
-    ({"tau": np.full((T, 7), np.nan)}, "tau"),
-    ({"rotor": 1}, "rotor"),
-    ({"friction": "yes"}, "friction"),
-    ({"weights": -np.ones(7)}, "weights"),
-    ({"weights": np.zeros(7)}, "weights"),
-    ({"weights": np.ones(6)}, "weights"),
-    ({"prior_weight": 1.0}, "prior_weight"),
-    ({"prior_weight": -1.0, "prior": "lwr"}, "prior_weight"),
-    ({"prior": "lwr"}, "prior_weight"),
-    ({"prior": "planar", "prior_weight": 1.0}, "prior"),
-    ({"prior": "inconsistent", "prior_weight": 1.0}, "prior"),
-    ({"prior": "other frames", "prior_weight": 1.0}, "prior"),
-    ({"prior": 3, "prior_weight": 1.0}, "prior"),
-    ({"mass_bounds": np.ones((6, 2))}, "mass_bounds"),
-    ({"mass_bounds": np.tile([2.0, 1.0], (7, 1))}, "mass_bounds"),
-    ({"mass_bounds": np.tile([-1.0, 1.0], (7, 1))}, "mass_bounds"),
-    ({"mass_bounds": np.tile([np.nan, 1.0], (7, 1))}, "mass_bounds"),
-    ({"total_mass": -3.0}, "total_mass"),
-    ({"total_mass": (5.0, 2.0)}, "total_mass"),
-    ({"total_mass": (1.0, 2.0, 3.0)}, "total_mass"),
-    ({"margin": 0.0}, "margin"),
-    ({"margin": np.inf}, "margin"),
-    ({"extra_columns": -1}, "extra_columns"),
-    ({"extra_columns": 2}, "Y"),
-])
+@pytest.mark.parametrize(
+    ("changes", "name"),
+    [
+        ({"robot": "kuka"}, "robot"),
+        ({"Y": np.zeros((10, 7, 5))}, "Y"),
+        ({"Y": np.zeros((10, 5, 91))}, "Y"),
+        ({"Y": np.zeros((13, 91))}, "Y"),
+        ({"Y": np.zeros(91)}, "Y"),
+        ({"Y": "text"}, "Y"),
+        ({"tau": np.zeros((3, 7))}, "tau"),
+        ({"tau": np.full((T, 7), np.nan)}, "tau"),
+        ({"rotor": 1}, "rotor"),
+        ({"friction": "yes"}, "friction"),
+        ({"weights": -np.ones(7)}, "weights"),
+        ({"weights": np.zeros(7)}, "weights"),
+        ({"weights": np.ones(6)}, "weights"),
+        ({"prior_weight": 1.0}, "prior_weight"),
+        ({"prior_weight": -1.0, "prior": "lwr"}, "prior_weight"),
+        ({"prior": "lwr"}, "prior_weight"),
+        ({"prior": "planar", "prior_weight": 1.0}, "prior"),
+        ({"prior": "inconsistent", "prior_weight": 1.0}, "prior"),
+        ({"prior": "other frames", "prior_weight": 1.0}, "prior"),
+        ({"prior": 3, "prior_weight": 1.0}, "prior"),
+        ({"mass_bounds": np.ones((6, 2))}, "mass_bounds"),
+        ({"mass_bounds": np.tile([2.0, 1.0], (7, 1))}, "mass_bounds"),
+        ({"mass_bounds": np.tile([-1.0, 1.0], (7, 1))}, "mass_bounds"),
+        ({"mass_bounds": np.tile([np.nan, 1.0], (7, 1))}, "mass_bounds"),
+        ({"total_mass": -3.0}, "total_mass"),
+        ({"total_mass": (5.0, 2.0)}, "total_mass"),
+        ({"total_mass": (1.0, 2.0, 3.0)}, "total_mass"),
+        ({"margin": 0.0}, "margin"),
+        ({"margin": np.inf}, "margin"),
+        ({"extra_columns": -1}, "extra_columns"),
+        ({"extra_columns": 2}, "Y"),
+    ],
+)
 def test_bad_arguments_raise_value_errors_naming_them(lwr, data, changes, name):
     changes = dict(changes)
     prior = changes.get("prior")
@@ -424,8 +455,14 @@ def log(lwr):
     """A simulated log: random states, the robot's torques plus offsets, no noise."""
     q, qd, qdd = states(lwr, 200, seed=31)
     offsets = np.array([0.5, -0.4, 0.0, 0.1, -0.2, 0.3, -0.1])
-    return Log(t=np.arange(200) * 0.005, q=q, qd=qd, qdd=qdd, tau=lwr.rnea(q, qd, qdd) + offsets,
-               source="simulated"), offsets
+    return Log(
+        t=np.arange(200) * 0.005,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        tau=lwr.rnea(q, qd, qdd) + offsets,
+        source="simulated",
+    ), offsets
 
 
 def test_identify_log_physical_saves_and_loads_the_robot(lwr, log, tmp_path):
@@ -435,11 +472,15 @@ def test_identify_log_physical_saves_and_loads_the_robot(lwr, log, tmp_path):
     log, offsets = log
     result = identify_log(log, lwr, rotor=True, friction=True, offset=True, physical=True)
     assert result.physical["status"] == "optimal" and result.robot.is_physically_consistent()
-    np.testing.assert_allclose(result.theta[-lwr.n:], offsets, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(result.theta[-lwr.n :], offsets, rtol=0, atol=1e-6)
     predicted = result.predict(log)
     np.testing.assert_allclose(predicted, log.tau, rtol=0, atol=1e-6 * np.abs(log.tau).max())
-    np.testing.assert_allclose(result.robot.rnea(log.q, log.qd, log.qdd) + offsets, predicted,
-                               rtol=0, atol=1e-6 * np.abs(log.tau).max())
+    np.testing.assert_allclose(
+        result.robot.rnea(log.q, log.qd, log.qdd) + offsets,
+        predicted,
+        rtol=0,
+        atol=1e-6 * np.abs(log.tau).max(),
+    )
     dynid.save_result(result, tmp_path / "result", plots=False)
     loaded = dynid.load_result(tmp_path / "result")
     np.testing.assert_array_equal(loaded.robot.params, result.robot.params)
@@ -452,11 +493,20 @@ def test_identify_log_physical_saves_and_loads_the_robot(lwr, log, tmp_path):
 def test_identify_log_takes_a_prior_model_file(lwr, log, tmp_path):
     log, _ = log
     path = save_model(lwr, tmp_path / "prior.json")
-    result = identify_log(log, lwr, rotor=True, friction=True, offset=True, physical=True,
-                          prior=path, prior_weight=1e-4)
+    result = identify_log(
+        log,
+        lwr,
+        rotor=True,
+        friction=True,
+        offset=True,
+        physical=True,
+        prior=path,
+        prior_weight=1e-4,
+    )
     truth = lwr.parameter_vector(True, True)
-    np.testing.assert_allclose(result.robot.parameter_vector(True, True), truth, rtol=0,
-                               atol=1e-5 * np.abs(truth).max())
+    np.testing.assert_allclose(
+        result.robot.parameter_vector(True, True), truth, rtol=0, atol=1e-5 * np.abs(truth).max()
+    )
     assert result.physical["prior"] == str(path) and result.physical["prior_weight"] == 1e-4
 
 
@@ -482,8 +532,16 @@ def test_identify_log_physical_with_excluded_joints_and_ols(lwr, log):
     with pytest.raises(dynid.RankDeficientError):
         identify_log(garbage, lwr, rotor=True, friction=True, offset=True, exclude_joints=(0,))
     with pytest.warns(RuntimeWarning, match="do not excite"):
-        result = identify_log(garbage, lwr, rotor=True, friction=True, offset=True,
-                              method="ols", exclude_joints=(0,), physical=True)
+        result = identify_log(
+            garbage,
+            lwr,
+            rotor=True,
+            friction=True,
+            offset=True,
+            method="ols",
+            exclude_joints=(0,),
+            physical=True,
+        )
     assert result.excluded == (0,) and result.physical["status"] == "optimal"
     error = result.predict(garbage) - garbage.tau
     assert np.abs(error[:, 1:]).max() < 1e-6 * np.abs(log.tau).max()

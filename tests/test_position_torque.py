@@ -8,14 +8,14 @@ out are those where the closed form says sin q, cos q are gravity columns.
 
 from __future__ import annotations
 
-import dynid
 import numpy as np
 import pytest
+
+import dynid
 from dynid.io import Log
 from dynid.io.result_files import load_result, save_result
 from dynid.log_identification import identify_log
 from dynid.position_torque import position_columns, position_names, position_torque_joints
-
 from test_log_identification import fourier_log
 
 KS = np.array([0.3, 0.0, -0.2, 0.5, 0.1, -0.4, 0.35])
@@ -26,8 +26,11 @@ OFFSET = np.linspace(-0.5, 0.5, 7)
 def pendulum(axis_vertical: bool) -> dynid.Robot:
     """One revolute joint: gravity along -z0 (the joint axis) or along -y0 (across it)."""
     gravity = [0.0, 0.0, -9.81] if axis_vertical else [0.0, -9.81, 0.0]
-    return dynid.Robot.from_dh([[0.4, 0.0, 0.0, 0.0]], gravity=gravity,
-                               params=[[2.0, 0.3, 0.05, 0.0, 0.1, 0.0, 0.0, 0.2, 0.0, 0.25]])
+    return dynid.Robot.from_dh(
+        [[0.4, 0.0, 0.0, 0.0]],
+        gravity=gravity,
+        params=[[2.0, 0.3, 0.05, 0.0, 0.1, 0.0, 0.0, 0.2, 0.0, 0.25]],
+    )
 
 
 def test_pendulum_position_torque_is_gravity_only_when_the_axis_is_horizontal():
@@ -89,31 +92,60 @@ def test_known_position_torque_is_recovered(lwr, physical):
     margin 1e-6 is the only bias) to 1e-4, and its prediction to 1e-4 of the torques."""
     log = log_with_position_torque(lwr, 1)
     kwargs = {"physical": True} if physical else {}
-    result = identify_log(log, lwr, rotor=True, friction=True, offset=True, method="ols",
-                          position_torque=True, **kwargs)
+    result = identify_log(
+        log,
+        lwr,
+        rotor=True,
+        friction=True,
+        offset=True,
+        method="ols",
+        position_torque=True,
+        **kwargs,
+    )
     assert result.position_joints == (0, 2, 3, 4, 5, 6)
     assert any("not on joint(s) 2" in note for note in result.training["notes"])
     joints = list(result.position_joints)
     truth = np.column_stack([KS[joints], KC[joints]]).reshape(-1)
-    assert result.names[-truth.size:] == ["ks1", "kc1", "ks3", "kc3", "ks4", "kc4", "ks5", "kc5",
-                                          "ks6", "kc6", "ks7", "kc7"]
+    assert result.names[-truth.size :] == [
+        "ks1",
+        "kc1",
+        "ks3",
+        "kc3",
+        "ks4",
+        "kc4",
+        "ks5",
+        "kc5",
+        "ks6",
+        "kc6",
+        "ks7",
+        "kc7",
+    ]
     expected = dynid.base_parameters(lwr, rotor=True, friction=True).values(lwr)
     scale = np.abs(expected).max()
     tolerance = 1e-4 if physical else 1e-8
-    np.testing.assert_allclose(result.theta[-truth.size:], truth, rtol=0, atol=tolerance * scale)
-    np.testing.assert_allclose(result.theta[-truth.size - 7:-truth.size], OFFSET, rtol=0,
-                               atol=tolerance * scale)
+    np.testing.assert_allclose(result.theta[-truth.size :], truth, rtol=0, atol=tolerance * scale)
+    np.testing.assert_allclose(
+        result.theta[-truth.size - 7 : -truth.size], OFFSET, rtol=0, atol=tolerance * scale
+    )
     if not physical:
-        np.testing.assert_allclose(result.theta[:expected.size], expected, rtol=0,
-                                   atol=1e-8 * scale)
+        np.testing.assert_allclose(
+            result.theta[: expected.size], expected, rtol=0, atol=1e-8 * scale
+        )
     other = log_with_position_torque(lwr, 4)
-    np.testing.assert_allclose(result.predict(other), other.tau, rtol=0,
-                               atol=tolerance * np.abs(other.tau).max())
+    np.testing.assert_allclose(
+        result.predict(other), other.tau, rtol=0, atol=tolerance * np.abs(other.tau).max()
+    )
 
 
 def test_save_and_load_keep_the_position_torque(lwr, tmp_path):
-    result = identify_log(log_with_position_torque(lwr, 1), lwr, rotor=True, friction=True,
-                          offset=True, position_torque=True)
+    result = identify_log(
+        log_with_position_torque(lwr, 1),
+        lwr,
+        rotor=True,
+        friction=True,
+        offset=True,
+        position_torque=True,
+    )
     loaded = load_result(save_result(result, tmp_path / "out"))
     assert loaded.position_joints == result.position_joints and loaded.position_torque
     other = fourier_log(lwr, 4, seconds=1.0)

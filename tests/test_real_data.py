@@ -43,8 +43,10 @@ TORQUE_LIMITS = np.array([176.0, 176.0, 100.0, 100.0, 100.0, 38.0, 38.0])
 
 @pytest.fixture(scope="module")
 def logs() -> tuple[Log, Log]:
-    return (load_log(DATA / "measurements_1.npz", skip=SKIP),
-            load_log(DATA / "measurements_2.npz", skip=SKIP))
+    return (
+        load_log(DATA / "measurements_1.npz", skip=SKIP),
+        load_log(DATA / "measurements_2.npz", skip=SKIP),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -81,8 +83,17 @@ def _flip(log: Log, joint: int) -> Log:
     return log.replace(q=log.q * sign, qd=log.qd * sign, qdd=log.qdd * sign)
 
 
-@pytest.mark.parametrize("variant", ["shuffled torques", "read as modified DH", "q1 flipped",
-                                     "q2 flipped", "q3 flipped", "q4 flipped"])
+@pytest.mark.parametrize(
+    "variant",
+    [
+        "shuffled torques",
+        "read as modified DH",
+        "q1 flipped",
+        "q2 flipped",
+        "q3 flipped",
+        "q4 flipped",
+    ],
+)
 def test_broken_pipelines_fail_the_bounds(logs, lwr, variant):
     train, check = logs
     robot = lwr
@@ -108,10 +119,12 @@ def test_the_data_follow_the_dh_table_of_kuka_lwr4(logs, correct):
     for name in ("kuka_lwr4plus_dh.json", "kuka_lwr4plus_modified_dh.json"):
         result = identify_log(train, load_model(EXAMPLES / name), **OPTIONS)
         assert (result.count, result.rank) == (paper.count, paper.rank)
-        np.testing.assert_allclose(result.predict(check), paper.predict(check), rtol=0,
-                                   atol=1e-8 * np.abs(check.tau).max())
-        np.testing.assert_allclose(validate_log(result, check)["relative_rms"],
-                                   metrics["relative_rms"], rtol=1e-7)
+        np.testing.assert_allclose(
+            result.predict(check), paper.predict(check), rtol=0, atol=1e-8 * np.abs(check.tau).max()
+        )
+        np.testing.assert_allclose(
+            validate_log(result, check)["relative_rms"], metrics["relative_rms"], rtol=1e-7
+        )
 
 
 def test_gravity_model_matches_the_measured_sign_and_zero(logs, lwr):
@@ -139,8 +152,10 @@ def test_gravity_model_matches_the_measured_sign_and_zero(logs, lwr):
 def test_reference_tables_of_the_data_file_match_the_examples():
     """examples/kuka_lwr4plus*.json hold the rows of tests/data/kuka_lwr4_dh.json."""
     source = json.loads((DATA / "kuka_lwr4_dh.json").read_text())
-    for kind, name in (("standard", "kuka_lwr4plus_dh.json"),
-                       ("modified", "kuka_lwr4plus_modified_dh.json")):
+    for kind, name in (
+        ("standard", "kuka_lwr4plus_dh.json"),
+        ("modified", "kuka_lwr4plus_modified_dh.json"),
+    ):
         example = json.loads((EXAMPLES / name).read_text())
         assert example["rows"] == source["dh"][kind]["rows"]
         assert example["convention"] == kind

@@ -53,8 +53,10 @@ RATIO_BOUND_POSITION = np.array([1.25, 1.25, 1.25, 1.25, 1.25, 1.25, 2.05])
 
 @pytest.fixture(scope="module")
 def logs():
-    return (load_log(DATA / "measurements_1.npz", skip=SKIP),
-            load_log(DATA / "measurements_2.npz", skip=SKIP))
+    return (
+        load_log(DATA / "measurements_1.npz", skip=SKIP),
+        load_log(DATA / "measurements_2.npz", skip=SKIP),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -74,8 +76,7 @@ def fits(logs, lwr):
 def position_fits(logs, lwr):
     train, check = logs
     ls = identify_log(train, lwr, **OPTIONS, position_torque=True)
-    physical = identify_log(train, lwr, **OPTIONS, position_torque=True, physical=True,
-                            prior=PRIOR)
+    physical = identify_log(train, lwr, **OPTIONS, position_torque=True, physical=True, prior=PRIOR)
     return ls, physical, validate_log(ls, check), validate_log(physical, check)
 
 
@@ -85,15 +86,18 @@ def test_the_prior_file_is_the_urdf_in_the_frames_of_kuka_lwr4(lwr):
     states, to 1e-12 N m: the same links, the parameters re-expressed exactly."""
     source = json.loads((DATA / "kuka_lwr4_dh.json").read_text())
     rows = source["dh"]["standard"]["rows"]
-    urdf = dynid.Robot.from_dh([[r["a"], r["alpha"], r["d"], r["theta_offset"]] for r in rows],
-                               params=source["params"]["kuka_lwr4.urdf (HEAD)"]["standard"])
+    urdf = dynid.Robot.from_dh(
+        [[r["a"], r["alpha"], r["d"], r["theta_offset"]] for r in rows],
+        params=source["params"]["kuka_lwr4.urdf (HEAD)"]["standard"],
+    )
     prior = dynid.load_model(PRIOR)
     np.testing.assert_array_equal(prior.dh, lwr.dh)
     rng = np.random.default_rng(0)
     q = lwr.random_configurations(50, seed=0)
     qd, qdd = rng.uniform(-2, 2, (2, 50, 7))
-    np.testing.assert_allclose(prior.rigid_body().rnea(q, qd, qdd), urdf.rnea(q, qd, qdd),
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        prior.rigid_body().rnea(q, qd, qdd), urdf.rnea(q, qd, qdd), rtol=0, atol=1e-12
+    )
     assert prior.is_physically_consistent()
     urdf_joints = source["joints"]
     np.testing.assert_array_equal(prior.Fv, [j["urdf_damping_HEAD"] for j in urdf_joints])
@@ -113,8 +117,7 @@ def test_physical_fit_validates_close_to_the_unconstrained_one(fits):
     np.testing.assert_allclose(masses, [2.7, 2.7, 2.7, 2.7, 1.7, 1.6, 0.3], atol=0.65)
 
 
-def test_with_the_position_torque_the_physical_fit_is_within_1_25_except_on_a7(position_fits,
-                                                                             fits):
+def test_with_the_position_torque_the_physical_fit_is_within_1_25_except_on_a7(position_fits, fits):
     """Both fits with the position torque: the table of docs/real_data.md (guard rtol 0.05),
     the ratio within 1.25 on A1-A6 (A7: 1.95, bound 2.05); and the physical fit with it is within
     1.25 x of the strict unconstrained fit (no position torque) on every joint (measured at most
@@ -166,10 +169,12 @@ def test_the_urdf_itself_is_the_same_prior(fits, logs, lwr):
     torques; the solver's tolerance)."""
     _, physical, _, _ = fits
     train, check = logs
-    urdf = identify_log(train, lwr, **OPTIONS, physical=True,
-                        prior=DATA / "urdf" / "kuka_lwr4.urdf")
-    np.testing.assert_allclose(urdf.predict(check), physical.predict(check), rtol=0,
-                               atol=1e-6 * np.abs(check.tau).max())
+    urdf = identify_log(
+        train, lwr, **OPTIONS, physical=True, prior=DATA / "urdf" / "kuka_lwr4.urdf"
+    )
+    np.testing.assert_allclose(
+        urdf.predict(check), physical.predict(check), rtol=0, atol=1e-6 * np.abs(check.tau).max()
+    )
 
 
 def test_physical_model_is_usable_where_the_unconstrained_one_is_not(fits, lwr):
@@ -178,7 +183,7 @@ def test_physical_model_is_usable_where_the_unconstrained_one_is_not(fits, lwr):
     robot is consistent and M(q) > 0 at all of them."""
     ls, physical, _, _ = fits
     q = lwr.random_configurations(2000, seed=4)
-    standard = np.linalg.lstsq(ls.beta, ls.theta[:ls.count], rcond=None)[0]
+    standard = np.linalg.lstsq(ls.beta, ls.theta[: ls.count], rcond=None)[0]
     unconstrained = lwr.copy()
     unconstrained.params = standard[:70].reshape(7, 10)
     unconstrained.Ia, unconstrained.Fv, unconstrained.Fs = standard[70:].reshape(3, 7)
@@ -191,8 +196,8 @@ def test_physical_model_is_usable_where_the_unconstrained_one_is_not(fits, lwr):
 def joint_side_torque(result, q: np.ndarray) -> np.ndarray:
     """The torque of the result's extra columns at q: offsets (+ ks sin q + kc cos q)."""
     zeros = np.zeros((1, q.size))
-    columns = result.regressor(q[None], zeros, zeros)[0, :, result.count:]
-    return columns @ result.theta[result.count:]
+    columns = result.regressor(q[None], zeros, zeros)[0, :, result.count :]
+    return columns @ result.theta[result.count :]
 
 
 def simulate(result, log, start: int, steps: int) -> np.ndarray:

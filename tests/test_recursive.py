@@ -81,9 +81,7 @@ def weighted_solution(
     weights = np.sqrt(forgetting ** np.arange(T - 1, -1, -1.0))
     rows = (Y * weights[:, None, None]).reshape(-1, p)
     rhs = (tau * weights[:, None]).reshape(-1)
-    prior_root = np.linalg.cholesky(
-        forgetting**T * prior_information
-    ).T  # R^T R = prior
+    prior_root = np.linalg.cholesky(forgetting**T * prior_information).T  # R^T R = prior
     A = np.vstack([rows, prior_root])
     b = np.concatenate([rhs, prior_root @ theta0])
     theta = np.linalg.lstsq(A, b, rcond=None)[0]
@@ -110,9 +108,7 @@ def test_forgetting_one_equals_ridge_batch_solution(lwr, c):
 
     W, t = Y.reshape(-1, base.count), tau.reshape(-1)
     augmented = np.vstack([W, np.eye(base.count) / np.sqrt(c)])
-    ridge = np.linalg.lstsq(
-        augmented, np.concatenate([t, np.zeros(base.count)]), rcond=None
-    )[0]
+    ridge = np.linalg.lstsq(augmented, np.concatenate([t, np.zeros(base.count)]), rcond=None)[0]
     assert relative(theta, ridge) < 1e-8
     assert np.array_equal(theta, rls.theta)
     P = np.linalg.inv(W.T @ W + np.eye(base.count) / c)
@@ -194,10 +190,7 @@ def test_matches_textbook_recursion(p, m, blocks, forgetting, log_c, seed):
     theta, P = textbook_recursion(Y, tau, forgetting, c)
     scale = np.linalg.norm(P)
     assert np.linalg.norm(rls.covariance - P) <= 1e-8 * scale
-    assert (
-        np.linalg.norm(rls.theta - theta)
-        <= 1e-8 * (np.linalg.norm(theta) + 1e-300) + 1e-12
-    )
+    assert np.linalg.norm(rls.theta - theta) <= 1e-8 * (np.linalg.norm(theta) + 1e-300) + 1e-12
 
 
 def test_batch_equals_sequential_updates_exactly(lwr):
@@ -220,9 +213,7 @@ def test_batch_equals_sequential_updates_exactly(lwr):
     single = RLS(base.count, 0.95)
     for Y_k, tau_k in zip(rows, torques):
         single.update(Y_k, float(tau_k))
-    assert np.array_equal(
-        RLS(base.count, 0.95).update_batch(rows, torques), single.theta
-    )
+    assert np.array_equal(RLS(base.count, 0.95).update_batch(rows, torques), single.theta)
 
 
 # --------------------------------------------------------------------------- behaviour
@@ -267,9 +258,7 @@ def test_tracks_a_payload_with_forgetting(lwr):
     forgetting = 0.99  # memory ~ 1 / (1 - lambda) = 100 samples
     history = RLS(base.count, forgetting).update_batch(Y, tau, history=True)
     error = np.linalg.norm(history[half:] - after, axis=1) / change
-    assert (
-        np.linalg.norm(history[half - 1] - before) < 0.01 * change
-    )  # converged before
+    assert np.linalg.norm(history[half - 1] - before) < 0.01 * change  # converged before
     assert error[0] > 0.5  # the change is seen as an error at first
     # The old data weigh lambda^k after k samples: the error decays below ~e^-1, e^-3, ...
     assert error[100] < 0.5
@@ -286,9 +275,7 @@ def test_tracks_a_payload_with_forgetting(lwr):
 def test_covariance_stays_symmetric_positive_definite_over_1e5_updates(lwr, forgetting):
     robot, base = lwr
     p = base.count
-    pool = lwr_blocks(
-        robot, base, 1000, seed=13
-    )  # 10^5 updates cycle through these blocks
+    pool = lwr_blocks(robot, base, 1000, seed=13)  # 10^5 updates cycle through these blocks
     rng = np.random.default_rng(14)
     theta_true = base.values(robot)
     rls = RLS(p, forgetting)
@@ -324,9 +311,7 @@ def test_windup_is_capped_in_unexcited_directions():
         assert rls.max_variance == (c if max_variance is None else max_variance)
         np.testing.assert_allclose(P[5:, 5:], expected * np.eye(p - 5), rtol=1e-12)
         assert np.all(P[:5, 5:] == 0.0)
-        reference, P_excited = weighted_solution(
-            Y[:, :, :5], tau, 0.9, np.eye(5) / c, np.zeros(5)
-        )
+        reference, P_excited = weighted_solution(Y[:, :, :5], tau, 0.9, np.eye(5) / c, np.zeros(5))
         assert relative(P[:5, :5], P_excited) < 1e-8
         assert relative(rls.theta[:5], reference) < 1e-8
     long = RLS(p, 0.9, c)
@@ -436,9 +421,7 @@ BAD_CALLS: list[tuple[str, Callable[[RLS], object]]] = [
     ),
     (
         "tau",
-        lambda r: r.update_batch(
-            np.ones((5, 2, P)), np.r_[np.ones((4, 2)), [[1.0, np.inf]]]
-        ),
+        lambda r: r.update_batch(np.ones((5, 2, P)), np.r_[np.ones((4, 2)), [[1.0, np.inf]]]),
     ),
     (
         "history",
@@ -470,9 +453,7 @@ def test_accepted_input_forms():
     Y = rng.normal(size=(6, 3, P))
     tau = rng.normal(size=(6, 3))
     expected = RLS(P).update_batch(Y, tau)
-    assert np.array_equal(
-        RLS(np.int64(P)).update_batch(Y.tolist(), tau.tolist()), expected
-    )
+    assert np.array_equal(RLS(np.int64(P)).update_batch(Y.tolist(), tau.tolist()), expected)
     assert np.array_equal(RLS(P).update_batch(np.asfortranarray(Y), tau), expected)
     wide = np.zeros((6, 3, 2 * P))
     wide[:, :, ::2] = Y
@@ -483,9 +464,7 @@ def test_accepted_input_forms():
     floats.update(np.arange(3.0 * P).reshape(3, P), [1.0, 2.0, 3.0])
     assert np.array_equal(integers.theta, floats.theta)
     empty = RLS(P)
-    assert np.array_equal(
-        empty.update_batch(np.ones((0, 2, P)), np.ones((0, 2))), np.zeros(P)
-    )
+    assert np.array_equal(empty.update_batch(np.ones((0, 2, P)), np.ones((0, 2))), np.zeros(P))
 
 
 # --------------------------------------------------------------------------- real time
@@ -507,9 +486,7 @@ def find_eigen() -> Path:
     for candidate in (Path("/usr/include/eigen3"), Path("/usr/local/include/eigen3")):
         if (candidate / "Eigen" / "Core").is_file():
             return candidate
-    pytest.fail(
-        "Eigen not found: pip install cmeel-eigen (or install the system's eigen3)"
-    )
+    pytest.fail("Eigen not found: pip install cmeel-eigen (or install the system's eigen3)")
 
 
 def test_update_makes_no_heap_allocation(tmp_path, record_property):
@@ -542,13 +519,9 @@ def test_update_makes_no_heap_allocation(tmp_path, record_property):
         timeout=600,
     )
     assert build.returncode == 0, build.stderr
-    run = subprocess.run(
-        [str(program)], check=False, capture_output=True, text=True, timeout=300
-    )
+    run = subprocess.run([str(program)], check=False, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
-    assert re.search(r"^allocations_during_updates=0$", run.stdout, re.MULTILINE), (
-        run.stdout
-    )
+    assert re.search(r"^allocations_during_updates=0$", run.stdout, re.MULTILINE), run.stdout
     timing = re.search(r"us_per_update_median=([0-9.]+)", run.stdout)
     assert timing, run.stdout
     # Reported, not asserted (the machine may be busy): the target is < 10 us per update.

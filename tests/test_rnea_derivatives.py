@@ -110,7 +110,9 @@ def test_coulomb_friction_and_rotor_inertia_do_not_enter() -> None:
     robot.Fv = robot.Fv + np.arange(robot.n)
     dq2, dqd2 = robot.rnea_derivatives(q, qd, qdd)
     np.testing.assert_allclose(dq2, dq, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(dqd2 - dqd, np.diag(np.arange(robot.n, dtype=float)), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        dqd2 - dqd, np.diag(np.arange(robot.n, dtype=float)), rtol=0, atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("threads", [1, 2])
@@ -161,5 +163,7 @@ def test_standard_and_modified_tables_of_the_same_arm_agree() -> None:
     states = [tuple(np.asarray(sample[k], dtype=float) for k in ("q", "qd", "qdd"))]
     states += [random_state(np.random.default_rng(9 + i), "R" * 7) for i in range(3)]
     for q, qd, qdd in states:
-        for a, b in zip(standard.rnea_derivatives(q, qd, qdd), modified.rnea_derivatives(q, qd, qdd)):
+        for a, b in zip(
+            standard.rnea_derivatives(q, qd, qdd), modified.rnea_derivatives(q, qd, qdd)
+        ):
             assert_close(a, b, 1e-9)

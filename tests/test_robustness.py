@@ -49,8 +49,9 @@ def test_base_parameter_cache_follows_gravity() -> None:
 
 
 def test_fourier_trajectory_overflow_is_an_error() -> None:
-    huge = excitation.FourierTrajectory(1.0, np.full((2, 3), 1e308), np.full((2, 3), 1e308),
-                                        np.zeros(2))
+    huge = excitation.FourierTrajectory(
+        1.0, np.full((2, 3), 1e308), np.full((2, 3), 1e308), np.zeros(2)
+    )
     with pytest.raises(ValueError, match=r"^t: .*overflow"):
         huge.evaluate(np.linspace(0.0, 1.0, 5))
     ordinary = excitation.FourierTrajectory(1.0, np.ones((2, 3)), np.ones((2, 3)), np.zeros(2))
@@ -79,11 +80,22 @@ def _robot() -> dynid.Robot:
     [
         (lambda: dynid.least_squares(np.eye(3), np.ones(3), names=5), "names"),
         (lambda: dynid.least_squares(np.eye(3), np.ones(3), names=["a", "b"]), "names"),
-        (lambda: dynid.identify_from_controller(_robot(), np.zeros((3, 7)), np.zeros((3, 7)),
-                                                np.zeros((3, 7, 7)), exclude_gravity_joints=None),
-         "exclude_gravity_joints"),
-        (lambda: dynid.identify_from_controller("robot", np.zeros((3, 7)), np.zeros((3, 7)),
-                                                np.zeros((3, 7, 7))), "structure"),
+        (
+            lambda: dynid.identify_from_controller(
+                _robot(),
+                np.zeros((3, 7)),
+                np.zeros((3, 7)),
+                np.zeros((3, 7, 7)),
+                exclude_gravity_joints=None,
+            ),
+            "exclude_gravity_joints",
+        ),
+        (
+            lambda: dynid.identify_from_controller(
+                "robot", np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7, 7))
+            ),
+            "structure",
+        ),
         (lambda: dynid.base_parameters("robot"), "robot"),
         (lambda: dynid.VirtualController("x"), "robot"),
         (lambda: dynid.base_parameters(_robot(), "torque", rotor="no"), "rotor"),
@@ -173,8 +185,9 @@ def test_robot_pickles_copies_and_compares() -> None:
     changed.Fs = np.ones(7)
     assert changed != robot
     assert robot != "robot"
-    assert np.array_equal(pickle.loads(pickle.dumps(robot.gravity))(np.zeros(7)),
-                          robot.gravity(np.zeros(7)))
+    assert np.array_equal(
+        pickle.loads(pickle.dumps(robot.gravity))(np.zeros(7)), robot.gravity(np.zeros(7))
+    )
 
 
 def test_results_pickle_and_compare(small_result) -> None:
@@ -208,14 +221,17 @@ def test_gravity_over_a_process_pool(method: str) -> None:
 
 def _write_bad_inputs(folder) -> dict[str, str]:
     files = {}
-    (folder / "rows300.json").write_text(json.dumps(
-        {"convention": "standard", "rows": [[0, 0, 0.1, 0]] * 300}))
+    (folder / "rows300.json").write_text(
+        json.dumps({"convention": "standard", "rows": [[0, 0, 0.1, 0]] * 300})
+    )
     files["rows300.json"] = "rows: 300 DH rows"
     (folder / "hugeint.json").write_text(
-        '{"convention": "standard", "rows": [[1' + "0" * 400 + ", 0, 0, 0]]}")
+        '{"convention": "standard", "rows": [[1' + "0" * 400 + ", 0, 0, 0]]}"
+    )
     files["hugeint.json"] = "rows[0]: expected numbers"
     (folder / "deep.json").write_text(
-        '{"convention": "standard", "rows": ' + "[" * 100000 + "]" * 100000 + "}")
+        '{"convention": "standard", "rows": ' + "[" * 100000 + "]" * 100000 + "}"
+    )
     files["deep.json"] = "nesting too deep"
     (folder / "wrongtype.json").write_text('{"convention": 5, "rows": [[0, 0, 0, 0]]}')
     files["wrongtype.json"] = "convention: expected"
@@ -228,8 +244,9 @@ def _write_bad_inputs(folder) -> dict[str, str]:
     return files
 
 
-@pytest.mark.parametrize("name", ["rows300.json", "hugeint.json", "deep.json", "wrongtype.json",
-                                  "bomb.yaml"])
+@pytest.mark.parametrize(
+    "name", ["rows300.json", "hugeint.json", "deep.json", "wrongtype.json", "bomb.yaml"]
+)
 def test_cli_model_file_errors_are_one_line(name, tmp_path, capsys) -> None:
     """Exit 2 and one line naming the file and the field; no traceback, no minutes of work."""
     expected = _write_bad_inputs(tmp_path)[name]
@@ -286,8 +303,14 @@ def _foreign_log(folder, scale: float = 1e9) -> tuple[str, str, io.Log]:
         columns[f"effort_{j}"] = reference.tau[:, j - 1]
     names = list(columns)
     csv_path, npz_path = folder / "ros.csv", folder / "ros.npz"
-    np.savetxt(csv_path, np.column_stack([columns[k] for k in names]), delimiter=",",
-               header=",".join(names), comments="", fmt="%.17g")
+    np.savetxt(
+        csv_path,
+        np.column_stack([columns[k] for k in names]),
+        delimiter=",",
+        header=",".join(names),
+        comments="",
+        fmt="%.17g",
+    )
     np.savez(npz_path, **columns)
     return str(csv_path), str(npz_path), reference
 
@@ -315,8 +338,18 @@ def test_foreign_log_columns_and_time_unit(tmp_path) -> None:
 
 def test_cli_foreign_log_warns_in_one_line(tmp_path, capsys) -> None:
     csv_path, _, _ = _foreign_log(tmp_path)
-    status = dynid.cli.main(["identify", csv_path, "--columns", "t=stamp,q=pos_*,tau=effort_*",
-                             "--skip", "4500", "--output", str(tmp_path / "out")])
+    status = dynid.cli.main(
+        [
+            "identify",
+            csv_path,
+            "--columns",
+            "t=stamp,q=pos_*,tau=effort_*",
+            "--skip",
+            "4500",
+            "--output",
+            str(tmp_path / "out"),
+        ]
+    )
     err = capsys.readouterr().err
     assert status == 0
     assert "dynid identify: warning: ros.csv: t: the median sampling rate" in err
@@ -346,10 +379,13 @@ def test_import_dynid_loads_no_plotting_or_optimisers() -> None:
     import sys
 
     heavy = ("matplotlib", "scipy.optimize", "scipy.signal", "scipy.ndimage")
-    code = ("import sys, dynid; dynid.Robot; dynid.models.kuka_lwr4(); "
-            f"print(','.join(m for m in {heavy!r} if m in sys.modules))")
-    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            check=True).stdout.strip()
+    code = (
+        "import sys, dynid; dynid.Robot; dynid.models.kuka_lwr4(); "
+        f"print(','.join(m for m in {heavy!r} if m in sys.modules))"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.strip()
     assert loaded == ""
 
 
@@ -388,5 +424,5 @@ def test_recursive_least_squares_pickles_its_whole_state() -> None:
     state = list(rls.__getstate__())
     state[5] = np.ones(3)  # D with the wrong length
     blank = dynid.RecursiveLeastSquares.__new__(dynid.RecursiveLeastSquares)
-    with pytest.raises(ValueError, match="state.D"):
+    with pytest.raises(ValueError, match=r"state\.D"):
         blank.__setstate__(tuple(state))

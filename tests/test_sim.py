@@ -35,16 +35,18 @@ def test_noise_free_readings_are_the_link_dynamics_without_drive_terms():
     np.testing.assert_array_equal(data.q, q)
     assert data.g.shape == (20, 7) and data.M.shape == (20, 7, 7)
     body = robot.rigid_body()
-    np.testing.assert_allclose(data.g, body.gravity(q), rtol=0,
-                               atol=1e-14 * np.abs(data.g).max())
-    np.testing.assert_allclose(data.M, body.mass_matrix(q), rtol=0,
-                               atol=1e-14 * np.abs(data.M).max())
+    np.testing.assert_allclose(data.g, body.gravity(q), rtol=0, atol=1e-14 * np.abs(data.g).max())
+    np.testing.assert_allclose(
+        data.M, body.mass_matrix(q), rtol=0, atol=1e-14 * np.abs(data.M).max()
+    )
     arm = ref.arm_of(robot)
     for k in range(3):
-        np.testing.assert_allclose(data.M[k], ref.mass_matrix(arm, q[k]), rtol=0,
-                                   atol=1e-10 * np.abs(data.M).max())
-        np.testing.assert_allclose(data.g[k], ref.gravity(arm, q[k]), rtol=0,
-                                   atol=1e-10 * np.abs(data.g).max())
+        np.testing.assert_allclose(
+            data.M[k], ref.mass_matrix(arm, q[k]), rtol=0, atol=1e-10 * np.abs(data.M).max()
+        )
+        np.testing.assert_allclose(
+            data.g[k], ref.gravity(arm, q[k]), rtol=0, atol=1e-10 * np.abs(data.g).max()
+        )
     # the controller works on its own copy: changing the robot afterwards changes nothing
     robot.params = 2 * robot.params
     np.testing.assert_array_equal(controller.read_static(q).g, data.g)
@@ -108,8 +110,9 @@ def test_position_noise_is_added_to_the_reported_q_only():
     q = controller.random_configurations(1000)
     data = controller.read_static(q)
     assert np.std(data.q - q) == pytest.approx(sigma, rel=0.05)
-    np.testing.assert_allclose(data.g, robot.rigid_body().gravity(q), rtol=0,
-                               atol=1e-14 * np.abs(data.g).max())
+    np.testing.assert_allclose(
+        data.g, robot.rigid_body().gravity(q), rtol=0, atol=1e-14 * np.abs(data.g).max()
+    )
 
 
 def test_same_seed_same_data_other_seed_other_data():
@@ -236,8 +239,9 @@ def test_paper_validation_trajectory_is_eq_33():
     t = np.linspace(0.0, 14.0, 57)
     q, qd, qdd = paper_validation_trajectory(t, n=7)
     assert q.shape == qd.shape == qdd.shape == (57, 7)
-    np.testing.assert_allclose(q, np.pi / 2 * np.cos(np.pi * t / 7)[:, None] * np.ones(7),
-                               rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        q, np.pi / 2 * np.cos(np.pi * t / 7)[:, None] * np.ones(7), rtol=0, atol=1e-14
+    )
     np.testing.assert_allclose(q[[0, -1]], np.pi / 2, rtol=0, atol=1e-14)
     np.testing.assert_allclose(qd[[0, -1]], 0.0, rtol=0, atol=1e-14)
     np.testing.assert_allclose(q[28], -np.pi / 2, rtol=0, atol=1e-14)  # t = 7 s
@@ -261,10 +265,16 @@ def test_bad_noise_levels_raise_value_error_naming_them(name, value):
 
 @pytest.mark.parametrize(
     ("kwargs", "name"),
-    [({"link_friction": -0.1}, "link_friction"), ({"link_friction": 1.5}, "link_friction"),
-     ({"link_friction": np.ones(6)}, "link_friction"), ({"link_friction": "a"}, "link_friction"),
-     ({"encoder_counts": 0}, "encoder_counts"), ({"encoder_counts": np.nan}, "encoder_counts"),
-     ({"encoder_counts": "many"}, "encoder_counts"), ({"encoder_counts": True}, "encoder_counts")],
+    [
+        ({"link_friction": -0.1}, "link_friction"),
+        ({"link_friction": 1.5}, "link_friction"),
+        ({"link_friction": np.ones(6)}, "link_friction"),
+        ({"link_friction": "a"}, "link_friction"),
+        ({"encoder_counts": 0}, "encoder_counts"),
+        ({"encoder_counts": np.nan}, "encoder_counts"),
+        ({"encoder_counts": "many"}, "encoder_counts"),
+        ({"encoder_counts": True}, "encoder_counts"),
+    ],
 )
 def test_bad_sensor_settings_raise_value_error_naming_them(kwargs, name):
     with pytest.raises(ValueError, match=rf"^{name}\b"):
@@ -286,8 +296,19 @@ def test_bad_sensor_settings_raise_value_error_naming_them(kwargs, name):
         (lambda c: c.track(paper_validation_trajectory, 1.0, gains=(1.0, -1.0)), "kd"),
         (lambda c: c.track(lambda t: t, 1.0), "trajectory"),
     ],
-    ids=["count-0", "count-neg", "duration-0", "duration-neg", "duration-nan", "rate-0",
-         "rate-inf", "gains-tuple", "kp-shape", "kd-negative", "trajectory"],
+    ids=[
+        "count-0",
+        "count-neg",
+        "duration-0",
+        "duration-neg",
+        "duration-nan",
+        "rate-0",
+        "rate-inf",
+        "gains-tuple",
+        "kp-shape",
+        "kd-negative",
+        "trajectory",
+    ],
 )
 def test_bad_arguments_raise_value_error_naming_them(call, name):
     controller = VirtualController(dynid.models.kuka_lwr4())

@@ -105,8 +105,9 @@ def test_semi_implicit_euler_energy_error_on_the_arm_is_first_order(lwr):
     # (measured: 1.7 J, 1.6 % of T_max, at h = 1e-4) where RK4 stays at 1e-10 J.
     errors = []
     for substeps in (1, 2, 4, 8):
-        run = simulate(lwr, Q0, QD0, 1.0, None, dt=8e-4, substeps=8 * substeps, friction=False,
-                       method="euler")
+        run = simulate(
+            lwr, Q0, QD0, 1.0, None, dt=8e-4, substeps=8 * substeps, friction=False, method="euler"
+        )
         errors.append(np.abs(energy(lwr, run.q, run.qd) - energy(lwr, Q0, QD0)).max())
         if substeps == 1:
             assert errors[0] < 1e-3 * lwr.kinetic_energy(run.q, run.qd).max()
@@ -141,8 +142,10 @@ def test_rk4_order_holds_under_a_held_controller_torque(lwr):
     law = PDGravity(lwr, KP, KD, np.zeros(7))
     options = {"dt": 1e-3, "friction": False}
     reference = simulate(lwr, Q0, QD0, 0.5, law, substeps=256, **options)
-    errors = [np.abs(simulate(lwr, Q0, QD0, 0.5, law, substeps=k, **options).q - reference.q).max()
-              for k in (1, 2, 4, 8)]
+    errors = [
+        np.abs(simulate(lwr, Q0, QD0, 0.5, law, substeps=k, **options).q - reference.q).max()
+        for k in (1, 2, 4, 8)
+    ]
     np.testing.assert_allclose(np.array(errors[:-1]) / np.array(errors[1:]), 16.0, rtol=0.06)
 
 
@@ -256,8 +259,9 @@ def test_applied_torque_is_the_plant_equation_and_noise_is_seeded(lwr):
         return plant.rnea(run.q, run.qd, run.qdd) + plant_friction(lwr, run.qd, 1e-3)
 
     clean = simulate(lwr, Q0, QD0, 2.0, law)
-    np.testing.assert_allclose(applied(clean), clean.tau, rtol=0,
-                               atol=1e-9 * np.abs(clean.tau).max())
+    np.testing.assert_allclose(
+        applied(clean), clean.tau, rtol=0, atol=1e-9 * np.abs(clean.tau).max()
+    )
     noisy = simulate(lwr, Q0, QD0, 2.0, law, torque_noise=0.05, seed=3)
     noise = applied(noisy) - noisy.tau
     assert np.std(noise) == pytest.approx(0.05, rel=0.03)
@@ -289,8 +293,9 @@ def test_encoder_quantises_what_the_controller_sees(lwr):
     qd_seen = np.array([s[1] for s in seen])
     np.testing.assert_array_equal(q_seen, run.q_measured)
     np.testing.assert_array_equal(qd_seen[0], QD0)
-    np.testing.assert_allclose(qd_seen[1:], np.diff(run.q_measured, axis=0) / 1e-3,
-                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        qd_seen[1:], np.diff(run.q_measured, axis=0) / 1e-3, rtol=0, atol=1e-9
+    )
     law = PDGravity(lwr, KP, KD, eq33)
     exact = simulate(lwr, Q0, None, 1.0, law)
     coarse = simulate(lwr, Q0, None, 1.0, law, encoder_counts=counts)
@@ -324,8 +329,11 @@ def test_builtin_controllers_run_without_the_gil(lwr):
     import time
 
     done = []
-    worker = threading.Thread(target=lambda: done.append(
-        simulate(lwr, Q0, QD0, 10.0, PDGravity(lwr, KP, KD, np.zeros(7)), dt=1e-4)))
+    worker = threading.Thread(
+        target=lambda: done.append(
+            simulate(lwr, Q0, QD0, 10.0, PDGravity(lwr, KP, KD, np.zeros(7)), dt=1e-4)
+        )
+    )
     start = last = time.perf_counter()
     longest = 0.0
     worker.start()
@@ -432,10 +440,22 @@ def test_the_documented_example_runs():
 # --- C++: no allocation per step ----------------------------------------------------------------
 
 # The sources the simulator and its controllers need.
-CORE_SOURCES = ("simulator", "controllers", "rnea", "crba", "gravity", "kinematics", "model",
-                "workspace", "rigid_body", "energy", "argument_checks",
-                # the vectorised sin/cos of the joint transforms (2-lane path, no special flags)
-                "batch_dispatch", "batch_lanes_sse2")
+CORE_SOURCES = (
+    "simulator",
+    "controllers",
+    "rnea",
+    "crba",
+    "gravity",
+    "kinematics",
+    "model",
+    "workspace",
+    "rigid_body",
+    "energy",
+    "argument_checks",
+    # the vectorised sin/cos of the joint transforms (2-lane path, no special flags)
+    "batch_dispatch",
+    "batch_lanes_sse2",
+)
 
 
 def find_compiler() -> str | None:
@@ -467,11 +487,23 @@ def test_simulator_runs_make_no_heap_allocation(tmp_path):
     program = tmp_path / "test_simulator_no_allocation"
     sources = [str(REPO / "cpp" / "src" / f"{name}.cpp") for name in CORE_SOURCES]
     build = subprocess.run(
-        [compiler, "-O2", "-DNDEBUG", "-std=c++17", f"-I{REPO / 'cpp' / 'include'}",
-         f"-I{REPO / 'cpp' / 'examples'}", f"-I{find_eigen()}",
-         str(REPO / "tests" / "cpp" / "test_simulator_no_allocation.cpp"), *sources,
-         "-o", str(program)],
-        check=False, capture_output=True, text=True, timeout=900,
+        [
+            compiler,
+            "-O2",
+            "-DNDEBUG",
+            "-std=c++17",
+            f"-I{REPO / 'cpp' / 'include'}",
+            f"-I{REPO / 'cpp' / 'examples'}",
+            f"-I{find_eigen()}",
+            str(REPO / "tests" / "cpp" / "test_simulator_no_allocation.cpp"),
+            *sources,
+            "-o",
+            str(program),
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=900,
     )
     assert build.returncode == 0, build.stderr
     run = subprocess.run([str(program)], check=False, capture_output=True, text=True, timeout=300)

@@ -42,8 +42,9 @@ def test_threaded_batches_equal_single_thread(two_threads):
     # scalar kernel, batches the SIMD lane kernel (tests/test_batch_lanes.py): 1e-12 relative.
     for t in (0, 1499, 1500, 2999):
         single_call = robot.rnea(q[t], qd[t], qdd[t])
-        np.testing.assert_allclose(threaded["rnea"][t], single_call, rtol=0,
-                                   atol=1e-12 * np.abs(single_call).max())
+        np.testing.assert_allclose(
+            threaded["rnea"][t], single_call, rtol=0, atol=1e-12 * np.abs(single_call).max()
+        )
 
 
 def test_errors_in_worker_threads_reach_python(two_threads):

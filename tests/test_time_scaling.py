@@ -51,8 +51,9 @@ def test_scaled_torques_equal_inverse_dynamics_on_the_scaled_trajectory(k, drive
 
     got = scale_torques(tau, g, k, qd=qd, robot=robot)
     np.testing.assert_allclose(got, expected, rtol=0, atol=TOL * np.abs(expected).max())
-    np.testing.assert_allclose(np.stack(scale_motion(qd, qdd, k)), np.stack([qd_s, qdd_s]),
-                               rtol=0, atol=1e-13)
+    np.testing.assert_allclose(
+        np.stack(scale_motion(qd, qdd, k)), np.stack([qd_s, qdd_s]), rtol=0, atol=1e-13
+    )
     # One sample (n,) gives the same as the trajectory's row.
     one = scale_torques(tau[7], g[7], k, qd=qd[7], robot=robot)
     np.testing.assert_allclose(one, expected[7], rtol=0, atol=TOL * np.abs(expected).max())
@@ -81,8 +82,9 @@ def test_without_friction_the_notes_formula_holds():
     k = 3.0
     np.testing.assert_allclose(scale_torques(tau, g, k), (tau - g) / 9.0 + g, rtol=0, atol=1e-14)
     expected = robot.rnea(*sinusoids(scale_time(t, k), 1.0, 2))
-    np.testing.assert_allclose(scale_torques(tau, g, k), expected, rtol=0,
-                               atol=TOL * np.abs(expected).max())
+    np.testing.assert_allclose(
+        scale_torques(tau, g, k), expected, rtol=0, atol=TOL * np.abs(expected).max()
+    )
 
 
 # --- the notes' numerical example (pp. 39-40) ---------------------------------------------------
@@ -95,8 +97,11 @@ def cubic(t: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rest-to-rest cubic from Q_START to Q_END in time T, exact derivatives."""
     s = (np.asarray(t) / T)[:, None]
     delta = Q_END - Q_START
-    return (Q_START + delta * (3 * s**2 - 2 * s**3), delta * (6 * s - 6 * s**2) / T,
-            delta * (6 - 12 * s) / T**2)
+    return (
+        Q_START + delta * (3 * s**2 - 2 * s**3),
+        delta * (6 * s - 6 * s**2) / T,
+        delta * (6 - 12 * s) / T**2,
+    )
 
 
 def test_notes_example_2r_slowed_from_half_a_second_to_one_second():
@@ -142,8 +147,11 @@ def test_notes_example_2r_slowed_from_half_a_second_to_one_second():
 @pytest.mark.parametrize("k", [0.0, -1.0, np.nan, np.inf, -np.inf, True, "2", None, 1j, 10**400])
 def test_bad_k_is_a_value_error_naming_k(k):
     tau = np.ones((3, 2))
-    for call in (lambda: scale_torques(tau, tau, k), lambda: scale_time([0.0, 1.0], k),
-                 lambda: scale_motion(tau, tau, k)):
+    for call in (
+        lambda: scale_torques(tau, tau, k),
+        lambda: scale_time([0.0, 1.0], k),
+        lambda: scale_motion(tau, tau, k),
+    ):
         with pytest.raises(ValueError, match=r"^k: expected a finite time-scaling factor k > 0"):
             call()
 
@@ -182,6 +190,7 @@ def test_scaling_for_torque_limits_reaches_the_limit_exactly(drives):
     # above): at the returned k the largest |tau| / tau_max is 1 (1e-10), a 1e-6 faster motion
     # violates it, and every slower one on a grid up to 100 k respects it.
     from dynid.time_scaling import scaling_for_torque_limits
+
     robot = dynid.models.kuka_lwr4()
     if drives == "rigid_body":
         robot = robot.rigid_body()
@@ -206,6 +215,7 @@ def test_scaling_for_torque_limits_on_the_notes_example_and_bad_limits():
     # limit is approached. With a 10 N m limit on joint 1 (and a loose one on joint 2) this is
     # checked against that formula (1e-12); a limit below the final gravity torque is refused.
     from dynid.time_scaling import scaling_for_torque_limits
+
     robot = dynid.models.planar_2r(m1=0.26, m2=0.26)
     t = np.linspace(0.0, 0.5, 501)
     q, qd, qdd = cubic(t, 0.5)

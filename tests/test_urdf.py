@@ -41,10 +41,16 @@ REAL = {
     "kinova": (DATA / "kinova_j2s6s200.urdf", None, "j2s6s200_end_effector"),
     "xarm7": (DATA / "xarm7.urdf", None, "link_eef"),
     "z1": (DATA / "z1.urdf", None, "link06"),  # the gripper held at 0
-    "talos_left_arm": ("talos_data/robots/talos_left_arm.urdf", "arm_left_1_link",
-                       "wrist_left_ft_tool_link"),
-    "talos_from_link2": ("talos_data/robots/talos_left_arm.urdf", "arm_left_2_link",
-                         "gripper_left_base_link"),  # base rotated: gravity re-expressed
+    "talos_left_arm": (
+        "talos_data/robots/talos_left_arm.urdf",
+        "arm_left_1_link",
+        "wrist_left_ft_tool_link",
+    ),
+    "talos_from_link2": (
+        "talos_data/robots/talos_left_arm.urdf",
+        "arm_left_2_link",
+        "gripper_left_base_link",
+    ),  # base rotated: gravity re-expressed
 }
 
 
@@ -70,7 +76,10 @@ def test_real_arm_matches_pinocchio(case: str, convention: str) -> None:
     for i, jid in enumerate(ref.joints):
         joint = ref.model.joints[jid]
         if joint.nq == 1:
-            limits = ref.model.lowerPositionLimit[joint.idx_q], ref.model.upperPositionLimit[joint.idx_q]
+            limits = (
+                ref.model.lowerPositionLimit[joint.idx_q],
+                ref.model.upperPositionLimit[joint.idx_q],
+            )
             np.testing.assert_array_equal(robot.qlim[i], limits)
         else:  # continuous: one turn
             np.testing.assert_array_equal(robot.qlim[i], [-np.pi, np.pi])
@@ -93,8 +102,9 @@ def test_lwr4_equals_the_hand_derived_tables(convention: str) -> None:
     # (a = theta = 0); tests/data/kuka_lwr4_dh.json the URDF inertials in those frames
     # (derived and checked against Pinocchio independently of dynid; 16 digits stored).
     data = json.loads((Path(__file__).parent / "data" / "kuka_lwr4_dh.json").read_text())
-    robot = dynid.Robot.from_urdf(DATA / "kuka_lwr4.urdf", base_link="lwr_base_link",
-                                  convention=convention)
+    robot = dynid.Robot.from_urdf(
+        DATA / "kuka_lwr4.urdf", base_link="lwr_base_link", convention=convention
+    )
     h = np.pi / 2
     if convention == "standard":
         alpha_d = [[h, 0.3105], [-h, 0], [-h, 0.4], [h, 0], [h, 0.39], [-h, 0], [0, 0.078]]
@@ -122,8 +132,18 @@ def _pseudo_inertia(params: np.ndarray) -> np.ndarray:
 def _from_pseudo_inertia(J: np.ndarray) -> np.ndarray:
     sigma = J[:3, :3]
     inertia = np.trace(sigma) * np.eye(3) - sigma
-    return np.array([J[3, 3], *J[:3, 3], inertia[0, 0], inertia[0, 1], inertia[0, 2],
-                     inertia[1, 1], inertia[1, 2], inertia[2, 2]])
+    return np.array(
+        [
+            J[3, 3],
+            *J[:3, 3],
+            inertia[0, 0],
+            inertia[0, 1],
+            inertia[0, 2],
+            inertia[1, 1],
+            inertia[1, 2],
+            inertia[2, 2],
+        ]
+    )
 
 
 def test_inertial_frame_change_is_the_pseudo_inertia_map(rng: np.random.Generator) -> None:
@@ -135,10 +155,13 @@ def test_inertial_frame_change_is_the_pseudo_inertia_map(rng: np.random.Generato
         mass = rng.uniform(0.1, 10.0)
         inertia = random_inertia_com(rng, mass)
         pose = random_pose(rng, 0.8)
-        J_c = _pseudo_inertia(np.array([mass, 0, 0, 0, *inertia[0], *inertia[1, 1:], inertia[2, 2]]))
+        J_c = _pseudo_inertia(
+            np.array([mass, 0, 0, 0, *inertia[0], *inertia[1, 1:], inertia[2, 2]])
+        )
         expected = _from_pseudo_inertia(pose @ J_c @ pose.T)
-        np.testing.assert_allclose(standard_parameters(mass, pose, inertia), expected,
-                                   rtol=1e-13, atol=1e-15 * mass)
+        np.testing.assert_allclose(
+            standard_parameters(mass, pose, inertia), expected, rtol=1e-13, atol=1e-15 * mass
+        )
 
 
 @pytest.mark.parametrize("convention", CONVENTIONS)
@@ -155,8 +178,15 @@ def test_link_parameters_are_pinocchios_inertias_in_dh_frames(case: str, convent
     for i, jid in enumerate(ref.joints):
         frame = frame @ _dh_transform(robot.dh[i], convention)
         inertia = ref.model.inertias[jid]
-        body = np.array([inertia.mass, *(inertia.mass * inertia.lever),
-                         *inertia.inertia[0], *inertia.inertia[1, 1:], inertia.inertia[2, 2]])
+        body = np.array(
+            [
+                inertia.mass,
+                *(inertia.mass * inertia.lever),
+                *inertia.inertia[0],
+                *inertia.inertia[1, 1:],
+                inertia.inertia[2, 2],
+            ]
+        )
         # Pinocchio's Inertia.inertia is about the CoM: to the joint origin first (pseudo-inertia
         # of a CoM-centred body moved by the lever).
         shift = np.eye(4)
@@ -165,8 +195,9 @@ def test_link_parameters_are_pinocchios_inertias_in_dh_frames(case: str, convent
         joint_pose = np.linalg.inv(ref.base_pose) @ ref.data.oMi[jid].homogeneous
         X = np.linalg.inv(frame) @ joint_pose
         expected = _from_pseudo_inertia(X @ J_joint @ X.T)
-        np.testing.assert_allclose(robot.params[i], expected, rtol=0,
-                                   atol=1e-12 * max(1.0, np.abs(expected).max()))
+        np.testing.assert_allclose(
+            robot.params[i], expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max())
+        )
 
 
 def _dh_transform(row: np.ndarray, convention: str) -> np.ndarray:
@@ -189,10 +220,12 @@ def _inertial(rng: np.random.Generator) -> str:
 
     mass = float(rng.uniform(0.2, 5.0))
     i = random_inertia_com(rng, mass).tolist()
-    return (f'<inertial><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
-            f'rpy="{_vec(rng.uniform(-np.pi, np.pi, 3))}"/><mass value="{mass!r}"/>'
-            f'<inertia ixx="{i[0][0]!r}" ixy="{i[0][1]!r}" ixz="{i[0][2]!r}" iyy="{i[1][1]!r}" '
-            f'iyz="{i[1][2]!r}" izz="{i[2][2]!r}"/></inertial>')
+    return (
+        f'<inertial><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
+        f'rpy="{_vec(rng.uniform(-np.pi, np.pi, 3))}"/><mass value="{mass!r}"/>'
+        f'<inertia ixx="{i[0][0]!r}" ixy="{i[0][1]!r}" ixz="{i[0][2]!r}" iyy="{i[1][1]!r}" '
+        f'iyz="{i[1][2]!r}" izz="{i[2][2]!r}"/></inertial>'
+    )
 
 
 def _unit(rng: np.random.Generator) -> np.ndarray:
@@ -205,16 +238,24 @@ def generated_urdf(seed: int) -> tuple[str, str]:
     (distinct lines), intersecting or coincident (same line); some chain links carry fixed
     children (merged) or a branch held at 0; the tip follows a fixed chain."""
     rng = np.random.default_rng(seed)
-    parts = ['<robot name="generated">', '<link name="world"/>',
-             f'<link name="base">{_inertial(rng)}</link>',
-             (f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
-             f'<origin xyz="{_vec(rng.uniform(-1, 1, 3))}" rpy="{_vec(rng.uniform(-3, 3, 3))}"/>'
-             '</joint>')]
+    parts = [
+        '<robot name="generated">',
+        '<link name="world"/>',
+        f'<link name="base">{_inertial(rng)}</link>',
+        (
+            f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
+            f'<origin xyz="{_vec(rng.uniform(-1, 1, 3))}" rpy="{_vec(rng.uniform(-3, 3, 3))}"/>'
+            "</joint>"
+        ),
+    ]
     parent, previous_axis = "base", None
     for k in range(int(rng.integers(2, 7))):
         kind = rng.choice(["revolute", "continuous", "prismatic"], p=[0.5, 0.2, 0.3])
-        relation = "skew" if previous_axis is None else rng.choice(
-            ["skew", "parallel", "intersecting", "coincident"])
+        relation = (
+            "skew"
+            if previous_axis is None
+            else rng.choice(["skew", "parallel", "intersecting", "coincident"])
+        )
         xyz, rpy, axis = rng.uniform(-0.4, 0.4, 3), rng.uniform(-np.pi, np.pi, 3), _unit(rng)
         if relation == "parallel":  # same direction in the same frame, shifted
             rpy, axis = np.zeros(3), previous_axis
@@ -223,31 +264,47 @@ def generated_urdf(seed: int) -> tuple[str, str]:
         elif relation == "coincident":
             xyz, rpy, axis = rng.uniform(-0.4, 0.4) * previous_axis, np.zeros(3), previous_axis
         if relation == "skew" and rng.random() < 0.4:  # a fixed link in between (merged)
-            parts += [f'<link name="fixed{k}">{_inertial(rng)}</link>',
-                      (f'<joint name="fix{k}" type="fixed"><parent link="{parent}"/>'
-                      f'<child link="fixed{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
-                      f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>')]
+            parts += [
+                f'<link name="fixed{k}">{_inertial(rng)}</link>',
+                (
+                    f'<joint name="fix{k}" type="fixed"><parent link="{parent}"/>'
+                    f'<child link="fixed{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
+                    f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>'
+                ),
+            ]
             parent = f"fixed{k}"
         limit = '<limit lower="-1.5" upper="2.5" effort="1" velocity="1"/>'
-        parts += [f'<link name="link{k}">{_inertial(rng)}</link>',
-                  (f'<joint name="joint{k}" type="{kind}"><parent link="{parent}"/>'
-                  f'<child link="link{k}"/><origin xyz="{_vec(xyz)}" rpy="{_vec(rpy)}"/>'
-                  f'<axis xyz="{_vec(axis)}"/>{limit if kind != "continuous" else ""}'
-                  f'<dynamics damping="{float(rng.uniform(0, 2))!r}" '
-                  f'friction="{float(rng.uniform(0, 1))!r}"/>'
-                  '</joint>')]
+        parts += [
+            f'<link name="link{k}">{_inertial(rng)}</link>',
+            (
+                f'<joint name="joint{k}" type="{kind}"><parent link="{parent}"/>'
+                f'<child link="link{k}"/><origin xyz="{_vec(xyz)}" rpy="{_vec(rpy)}"/>'
+                f'<axis xyz="{_vec(axis)}"/>{limit if kind != "continuous" else ""}'
+                f'<dynamics damping="{float(rng.uniform(0, 2))!r}" '
+                f'friction="{float(rng.uniform(0, 1))!r}"/>'
+                "</joint>"
+            ),
+        ]
         if rng.random() < 0.3:  # a branch: a leaf held at 0 (revolute) or rigidly fixed
             branch = rng.choice(["revolute", "fixed"])
-            parts += [f'<link name="branch{k}">{_inertial(rng)}</link>',
-                      (f'<joint name="branch_joint{k}" type="{branch}"><parent link="link{k}"/>'
-                      f'<child link="branch{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}"/>'
-                      f'<axis xyz="{_vec(_unit(rng))}"/>{limit}</joint>')]
+            parts += [
+                f'<link name="branch{k}">{_inertial(rng)}</link>',
+                (
+                    f'<joint name="branch_joint{k}" type="{branch}"><parent link="link{k}"/>'
+                    f'<child link="branch{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}"/>'
+                    f'<axis xyz="{_vec(_unit(rng))}"/>{limit}</joint>'
+                ),
+            ]
         parent, previous_axis = f"link{k}", axis
     for k in range(int(rng.integers(0, 3))):  # fixed chain after the last joint -> tool
-        parts += [f'<link name="flange{k}">{_inertial(rng)}</link>',
-                  (f'<joint name="flange_joint{k}" type="fixed"><parent link="{parent}"/>'
-                  f'<child link="flange{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
-                  f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>')]
+        parts += [
+            f'<link name="flange{k}">{_inertial(rng)}</link>',
+            (
+                f'<joint name="flange_joint{k}" type="fixed"><parent link="{parent}"/>'
+                f'<child link="flange{k}"/><origin xyz="{_vec(rng.uniform(-0.3, 0.3, 3))}" '
+                f'rpy="{_vec(rng.uniform(-3, 3, 3))}"/></joint>'
+            ),
+        ]
         parent = f"flange{k}"
     return "\n".join([*parts, "</robot>"]), parent
 
@@ -264,9 +321,11 @@ def test_hand_made_skew_axis_and_prismatic_joint() -> None:
     # The brief's case: axis "0.6 0 0.8" under a non-zero rpy, then a prismatic joint along a
     # general axis, then a revolute joint parallel to the first, a fixed flange with a mass.
     def inertial(m: float, xyz: str) -> str:
-        return (f'<inertial><origin xyz="{xyz}" rpy="0.1 -0.2 0.3"/><mass value="{m}"/>'
-                '<inertia ixx="0.02" ixy="0.001" ixz="-0.002" iyy="0.03" iyz="0.0015" izz="0.025"/>'
-                '</inertial>')
+        return (
+            f'<inertial><origin xyz="{xyz}" rpy="0.1 -0.2 0.3"/><mass value="{m}"/>'
+            '<inertia ixx="0.02" ixy="0.001" ixz="-0.002" iyy="0.03" iyz="0.0015" izz="0.025"/>'
+            "</inertial>"
+        )
 
     text = f"""<robot name="hand_made">
       <link name="root"/>
@@ -295,8 +354,10 @@ def test_hand_made_skew_axis_and_prismatic_joint() -> None:
         assert_matches_pinocchio(robot, text, None, "flange")
 
 
-NEAR = ('<inertial><origin xyz="0.1 0.05 0.2" rpy="0.3 0.2 0.1"/><mass value="1.5"/>'
-        '<inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.025"/></inertial>')
+NEAR = (
+    '<inertial><origin xyz="0.1 0.05 0.2" rpy="0.3 0.2 0.1"/><mass value="1.5"/>'
+    '<inertia ixx="0.02" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.025"/></inertial>'
+)
 
 
 def _nearly_parallel_urdf(angle: float) -> str:

@@ -11,8 +11,10 @@ import pytest
 import dynid
 
 DATA = Path(__file__).parent / "data" / "urdf"
-INERTIAL = ('<inertial><mass value="1"/>'
-            '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')
+INERTIAL = (
+    '<inertial><mass value="1"/>'
+    '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
+)
 
 
 def chain(*joints: str, links: str = "") -> str:
@@ -22,9 +24,11 @@ def chain(*joints: str, links: str = "") -> str:
 
 
 def joint(name: str, parent: str, child: str, kind: str = "revolute", extra: str = "") -> str:
-    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-            f'<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>{extra}'
-            "</joint>")
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>{extra}'
+        "</joint>"
+    )
 
 
 SERIAL = (joint("j1", "l0", "l1"), joint("j2", "l1", "l2"), joint("j3", "l2", "l3"))
@@ -52,8 +56,11 @@ def test_floating_and_planar_joints_are_named(kind: str) -> None:
 
 
 def test_mimic_joint_on_the_chain_is_named() -> None:
-    text = chain(joint("j1", "l0", "l1"), joint("j2", "l1", "l2", extra='<mimic joint="j1"/>'),
-                 joint("j3", "l2", "l3"))
+    text = chain(
+        joint("j1", "l0", "l1"),
+        joint("j2", "l1", "l2", extra='<mimic joint="j1"/>'),
+        joint("j3", "l2", "l3"),
+    )
     with pytest.raises(ValueError, match=r"joint 'j2'.*mimic"):
         dynid.Robot.from_urdf(text)
 
@@ -63,8 +70,11 @@ def test_missing_inertial_names_the_link() -> None:
     with pytest.raises(ValueError, match=r"link 'l2'.*joint 'j2'.*inertial"):
         dynid.Robot.from_urdf(text)
     # massless frames fixed to a moving link are fine (tool0, ee_link of industrial URDFs)
-    text = chain(*SERIAL, '<joint name="f" type="fixed"><parent link="l3"/><child link="t"/></joint>',
-                 links='<link name="t"/>')
+    text = chain(
+        *SERIAL,
+        '<joint name="f" type="fixed"><parent link="l3"/><child link="t"/></joint>',
+        links='<link name="t"/>',
+    )
     assert dynid.Robot.from_urdf(text).n == 3
 
 
@@ -77,23 +87,35 @@ def test_missing_inertial_names_the_link() -> None:
         ('<robot name="t"/>', "no <link>"),
         (chain(joint("j1", "l0", "l1", "screw")), "joint 'j1': unknown type 'screw'"),
         (chain(joint("j1", "l0", "nowhere")), "joint 'j1'.*child"),
-        (chain(joint("j1", "l0", "l1").replace('xyz="0 0 1"', 'xyz="0 0 0"')),
-         "joint 'j1'.*zero length"),
-        (chain(joint("j1", "l0", "l1").replace('xyz="0 0 1"', 'xyz="0 1"')),
-         "joint 'j1' <axis>.*3 finite numbers"),
-        (chain(joint("j1", "l0", "l1").replace('lower="-1"', 'lower="2"')),
-         "joint 'j1'.*lower < upper"),
-        (chain(*SERIAL).replace('<mass value="1"/>', '<mass value="heavy"/>', 1),
-         "link 'l0' <inertial> <mass>"),
+        (
+            chain(joint("j1", "l0", "l1").replace('xyz="0 0 1"', 'xyz="0 0 0"')),
+            "joint 'j1'.*zero length",
+        ),
+        (
+            chain(joint("j1", "l0", "l1").replace('xyz="0 0 1"', 'xyz="0 1"')),
+            "joint 'j1' <axis>.*3 finite numbers",
+        ),
+        (
+            chain(joint("j1", "l0", "l1").replace('lower="-1"', 'lower="2"')),
+            "joint 'j1'.*lower < upper",
+        ),
+        (
+            chain(*SERIAL).replace('<mass value="1"/>', '<mass value="heavy"/>', 1),
+            "link 'l0' <inertial> <mass>",
+        ),
         (chain(*SERIAL).replace(' ixy="0"', "", 1), "link 'l0'.*'ixy'"),
         (chain(*SERIAL, joint("j4", "l3", "l1")), "link 'l1' is the child of two joints"),
         (chain(joint("j1", "l0", "l1"), joint("j2", "l2", "l3")), "one root link"),
         (chain(*SERIAL).replace('<link name="l1">', '<link name="l2">', 1), "two links named 'l2'"),
         (chain(*SERIAL[:2], joint("j1", "l2", "l3")), "two joints named 'j1'"),
-        (chain(*(joint(f"f{i}", f"l{i}", f"l{i + 1}", "fixed") for i in range(3))),
-         "no movable joint"),
-        (chain(joint("j1", "l0", "l1"), joint("j2", "l2", "l3"), joint("j3", "l3", "l2")),
-         "not connected to the root"),
+        (
+            chain(*(joint(f"f{i}", f"l{i}", f"l{i + 1}", "fixed") for i in range(3))),
+            "no movable joint",
+        ),
+        (
+            chain(joint("j1", "l0", "l1"), joint("j2", "l2", "l3"), joint("j3", "l3", "l2")),
+            "not connected to the root",
+        ),
     ],
 )
 def test_malformed_urdf_is_a_value_error(text: str, message: str) -> None:
@@ -134,8 +156,9 @@ def test_base_link_and_tip_link_select_the_chain() -> None:
     q = np.linspace(-1.0, 1.0, 7)
     np.testing.assert_array_equal(full.fkine(q), explicit.fkine(q))  # the single leaf
     # a sub-chain: joints 3..5 of the arm (base_link lwr_2_link, tip lwr_5_link)
-    sub = dynid.Robot.from_urdf(DATA / "kuka_lwr4.urdf", base_link="lwr_2_link",
-                                tip_link="lwr_5_link")
+    sub = dynid.Robot.from_urdf(
+        DATA / "kuka_lwr4.urdf", base_link="lwr_2_link", tip_link="lwr_5_link"
+    )
     assert sub.n == 3
     np.testing.assert_array_equal(sub.qlim, full.qlim[2:5])
     np.testing.assert_array_equal(sub.Fv, full.Fv[2:5])

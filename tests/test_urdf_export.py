@@ -45,8 +45,9 @@ def assert_same_dynamics(robot: dynid.Robot, other: dynid.Robot, seed: int = 0) 
 @pytest.mark.parametrize("case", sorted(ROBOTS))
 def test_round_trip_through_dynid(case: str, convention: str) -> None:
     robot = ROBOTS[case]
-    back = dynid.Robot.from_urdf(robot.to_urdf(name=case), convention=convention,
-                                 gravity=robot.gravity_vector)
+    back = dynid.Robot.from_urdf(
+        robot.to_urdf(name=case), convention=convention, gravity=robot.gravity_vector
+    )
     assert back.joint_types == robot.joint_types and back.name == case
     assert_same_dynamics(robot, back)  # Ia comes back from the dynid comment
     np.testing.assert_array_equal(back.Ia, robot.Ia)
@@ -89,7 +90,10 @@ def test_urdf_content() -> None:
     assert text.startswith('<?xml version="1.0"?>\n<robot name="lwr">')
     # Ia in a comment of each joint, with the value that reads back exactly
     for i, value in enumerate(robot.Ia, start=1):
-        assert f'<joint name="joint{i}" type="revolute">\n    <!-- dynid: Ia="{float(value)!r}"' in text
+        assert (
+            f'<joint name="joint{i}" type="revolute">\n    <!-- dynid: Ia="{float(value)!r}"'
+            in text
+        )
     assert text.count("<link ") == robot.n + 2 and text.count("<joint ") == robot.n + 1
     assert '<axis xyz="0 0 1" />' in text
     assert "-0.0" not in re.findall(r"[-+.\de]+", text)  # no negative zeros printed

@@ -201,6 +201,15 @@ def polish(text: str) -> tuple[str, list[str]]:
             setter = m["name"]
             out.append(line)
             continue
+        if line.rstrip().endswith("(*args, **kwargs):"):
+            # The full pybind11 methods behind the fast single-call path (Model._rnea_full, ...):
+            # they take whatever the public method takes.
+            out.append(
+                line.replace(
+                    "(*args, **kwargs):", "(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:"
+                )
+            )
+            continue
         if m := DEF.match(line):
             func = m["name"]
             params = [

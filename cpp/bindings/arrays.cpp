@@ -26,7 +26,8 @@ py::object numpy_array(py::handle obj, bool as_double) {
   PyObject* descr = as_double ? py::dtype::of<double>().release().ptr() : nullptr;
   const int flags = py::detail::npy_api::NPY_ARRAY_ENSUREARRAY_ |
                     (as_double ? py::array::c_style | py::array::forcecast : 0);
-  return py::reinterpret_steal<py::object>(api.PyArray_FromAny_(obj.ptr(), descr, 0, 0, flags, nullptr));
+  return py::reinterpret_steal<py::object>(
+      api.PyArray_FromAny_(obj.ptr(), descr, 0, 0, flags, nullptr));
 }
 
 // A conversion that failed for lack of memory (a huge list, or the float64 copy of a broadcast
@@ -186,15 +187,17 @@ std::vector<int> parse_columns(py::handle obj, int count) {
   if (!raw) PyErr_Clear();
   const char kind = raw ? raw.dtype().kind() : '\0';
   if (!raw || raw.ndim() != 1 || raw.size() == 0 || (kind != 'i' && kind != 'u'))
-    throw py::value_error("columns: expected a non-empty 1-D array of integer column indices, got " +
-                          std::string(py::repr(obj)));
-  const auto values = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(raw);
+    throw py::value_error(
+        "columns: expected a non-empty 1-D array of integer column indices, got " +
+        std::string(py::repr(obj)));
+  const auto values =
+      py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(raw);
   std::vector<int> columns(static_cast<std::size_t>(values.size()));
   for (py::ssize_t k = 0; k < values.size(); ++k) {
     const long long c = values.data()[k];
     if (c < 0 || c >= count)
-      throw py::value_error("columns: expected indices in [0, " + std::to_string(count) + "), got " +
-                            std::to_string(c) + " at position " + std::to_string(k));
+      throw py::value_error("columns: expected indices in [0, " + std::to_string(count) +
+                            "), got " + std::to_string(c) + " at position " + std::to_string(k));
     columns[static_cast<std::size_t>(k)] = static_cast<int>(c);
   }
   return columns;
@@ -206,7 +209,8 @@ Array parse_fixed(py::handle obj, const char* name, const std::vector<py::ssize_
   for (std::size_t k = 0; ok && k < shape.size(); ++k) ok = a.shape(k) == shape[k];
   if (!ok) {
     std::string want = "(";
-    for (std::size_t k = 0; k < shape.size(); ++k) want += (k ? ", " : "") + std::to_string(shape[k]);
+    for (std::size_t k = 0; k < shape.size(); ++k)
+      want += (k ? ", " : "") + std::to_string(shape[k]);
     if (shape.size() == 1) want += ",";
     throw py::value_error(std::string(name) + ": expected shape " + want + "), got " +
                           shape_string(a));

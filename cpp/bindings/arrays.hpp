@@ -41,7 +41,7 @@ Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> 
 
 // Scalars with the type checks of SPEC section 2 (a wrong type is a ValueError naming the
 // argument, not pybind11's TypeError). NumPy scalars and 0-d arrays count as scalars.
-int parse_count(py::handle obj, const char* name);     // an integer >= 1
+int parse_count(py::handle obj, const char* name);      // an integer >= 1
 double parse_number(py::handle obj, const char* name);  // a real number
 bool parse_flag(py::handle obj, const char* name);      // True or False
 

@@ -35,8 +35,9 @@ constexpr py::ssize_t kChunk = 256;
 // A chunk of about `budget` elementary operations when one sample costs `work_per_sample`.
 inline py::ssize_t chunk_for_work(double work_per_sample, double budget = 65536.0) {
   const double samples = budget / std::max(work_per_sample, 1.0);
-  return samples >= static_cast<double>(kChunk) ? kChunk
-                                                 : std::max<py::ssize_t>(1, static_cast<py::ssize_t>(samples));
+  return samples >= static_cast<double>(kChunk)
+             ? kChunk
+             : std::max<py::ssize_t>(1, static_cast<py::ssize_t>(samples));
 }
 constexpr std::chrono::milliseconds kInterruptInterval{20};
 
@@ -56,12 +57,12 @@ class InterruptCheck {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-// Runs worker(begin, end) over [0, count) in chunks of `chunk` samples; make_worker() builds one worker per thread
-// (in that thread: its workspace). Call with the GIL held; returns the number of threads that
-// took part. Raises the first exception of any thread, or the signal handler's exception.
+// Runs worker(begin, end) over [0, count) in chunks of `chunk` samples; make_worker() builds one
+// worker per thread (in that thread: its workspace). Call with the GIL held; returns the number of
+// threads that took part. Raises the first exception of any thread, or the signal handler's
+// exception.
 template <class MakeWorker>
-int run_batch(py::ssize_t count, int threads, MakeWorker make_worker,
-              py::ssize_t chunk = kChunk) {
+int run_batch(py::ssize_t count, int threads, MakeWorker make_worker, py::ssize_t chunk = kChunk) {
   using Worker = decltype(make_worker());
   std::atomic<py::ssize_t> next{0};
   std::atomic<bool> stop{false};

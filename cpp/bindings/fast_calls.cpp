@@ -1,9 +1,10 @@
 // A fast path for single-sample calls (rnea(q, qd, qdd), mass_matrix(q), gravity(q) and the
-// other per-sample methods of model.cpp) with positional float64 vectors of length n, entered through CPython's vectorcall protocol
-// (METH_FASTCALL) instead of pybind11's generic dispatch, with the result allocated by NumPy's
-// C API directly. Everything else (keywords, out=, batches, lists, other dtypes, wrong shapes,
-// non-finite values) goes to the pybind11 method unchanged, so behaviour and error messages are
-// those of model.cpp; the fast path only skips work for the inputs that need none.
+// other per-sample methods of model.cpp) with positional float64 vectors of length n, entered
+// through CPython's vectorcall protocol (METH_FASTCALL) instead of pybind11's generic dispatch,
+// with the result allocated by NumPy's C API directly. Everything else (keywords, out=, batches,
+// lists, other dtypes, wrong shapes, non-finite values) goes to the pybind11 method unchanged, so
+// behaviour and error messages are those of model.cpp; the fast path only skips work for the inputs
+// that need none.
 #include <Python.h>
 
 #include <string>
@@ -38,7 +39,8 @@ const double* plain_vector(PyObject* obj, int n) {
 PyObject* new_array(int rows, int cols) {
   const auto& api = npy::npy_api::get();
   Py_intptr_t dims[2] = {rows, cols};
-  return api.PyArray_NewFromDescr_(api.PyArray_Type_, api.PyArray_DescrFromType_(npy::npy_api::NPY_DOUBLE_),
+  return api.PyArray_NewFromDescr_(api.PyArray_Type_,
+                                   api.PyArray_DescrFromType_(npy::npy_api::NPY_DOUBLE_),
                                    cols ? 2 : 1, dims, nullptr, nullptr, 0, nullptr);
 }
 
@@ -91,7 +93,8 @@ PyObject* fast_call(PyObject* self, PyObject* const* args, Py_ssize_t nargsf, Py
   PyObject* out = nullptr;
   if (d.rows > 0 && !(out = new_array(d.rows, d.cols))) return nullptr;
   double* data = out ? reinterpret_cast<double*>(npy::array_proxy(out)->data) : &scalar;
-  const py::ssize_t size = d.rows > 0 ? static_cast<py::ssize_t>(d.rows) * (d.cols ? d.cols : 1) : 1;
+  const py::ssize_t size =
+      d.rows > 0 ? static_cast<py::ssize_t>(d.rows) * (d.cols ? d.cols : 1) : 1;
   bool ok = true;
   try {
     kernel(*m->model, *m->ws, in, data, n);
@@ -110,107 +113,130 @@ Dims vector_dims(int n) { return {n, 0}; }
 Dims square_dims(int n) { return {n, n}; }
 
 PyObject* fast_rnea(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<0, 3>(self, a, f, kw, vector_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
-    OutVec tau(out, n);
-    rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
-  });
+  return fast_call<0, 3>(
+      self, a, f, kw, vector_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        OutVec tau(out, n);
+        rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
+      });
 }
 PyObject* fast_mass_matrix(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<1, 1>(self, a, f, kw, square_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
-    OutMat M = row_major(out, n, n);
-    crba(m, ws, ConstVec(in[0], n), M);
-  });
+  return fast_call<1, 1>(self, a, f, kw, square_dims,
+                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
+                           OutMat M = row_major(out, n, n);
+                           crba(m, ws, ConstVec(in[0], n), M);
+                         });
 }
 PyObject* fast_gravity(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<2, 1>(self, a, f, kw, vector_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
-    OutVec g(out, n);
-    gravity(m, ws, ConstVec(in[0], n), g);
-  });
+  return fast_call<2, 1>(self, a, f, kw, vector_dims,
+                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
+                           OutVec g(out, n);
+                           gravity(m, ws, ConstVec(in[0], n), g);
+                         });
 }
 PyObject* fast_coriolis(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<3, 2>(self, a, f, kw, vector_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
-    OutVec c(out, n);
-    coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
-  });
+  return fast_call<3, 2>(self, a, f, kw, vector_dims,
+                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
+                           OutVec c(out, n);
+                           coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
+                         });
 }
 PyObject* fast_coriolis_matrix(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<4, 2>(self, a, f, kw, square_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
-    OutMat S = row_major(out, n, n);
-    coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
-  });
+  return fast_call<4, 2>(self, a, f, kw, square_dims,
+                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
+                           OutMat S = row_major(out, n, n);
+                           coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
+                         });
 }
 PyObject* fast_friction(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<5, 1>(self, a, f, kw, vector_dims, [](const Model& m, Workspace&, In in, double* out, int n) {
-    OutVec tau(out, n);
-    friction(m, ConstVec(in[0], n), tau);
-  });
+  return fast_call<5, 1>(self, a, f, kw, vector_dims,
+                         [](const Model& m, Workspace&, In in, double* out, int n) {
+                           OutVec tau(out, n);
+                           friction(m, ConstVec(in[0], n), tau);
+                         });
 }
 PyObject* fast_forward_dynamics(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<6, 3>(self, a, f, kw, vector_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
-    OutVec qdd(out, n);
-    forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), qdd);
-  });
+  return fast_call<6, 3>(
+      self, a, f, kw, vector_dims, [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        OutVec qdd(out, n);
+        forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), qdd);
+      });
 }
 PyObject* fast_kinetic_energy(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<7, 2>(self, a, f, kw, [](int) { return Dims{0, 0}; },
-                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                           *out = kinetic_energy(m, ws, ConstVec(in[0], n), ConstVec(in[1], n));
-                         });
+  return fast_call<7, 2>(
+      self, a, f, kw, [](int) { return Dims{0, 0}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        *out = kinetic_energy(m, ws, ConstVec(in[0], n), ConstVec(in[1], n));
+      });
 }
 PyObject* fast_potential_energy(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<8, 1>(self, a, f, kw, [](int) { return Dims{0, 0}; },
-                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                           *out = potential_energy(m, ws, ConstVec(in[0], n));
-                         });
+  return fast_call<8, 1>(
+      self, a, f, kw, [](int) { return Dims{0, 0}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        *out = potential_energy(m, ws, ConstVec(in[0], n));
+      });
 }
 PyObject* fast_fkine(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<9, 1>(self, a, f, kw, [](int) { return Dims{4, 4}; },
-                         [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                           OutMat T = row_major(out, 4, 4);
-                           fkine(m, ws, ConstVec(in[0], n), T);
-                         });
+  return fast_call<9, 1>(
+      self, a, f, kw, [](int) { return Dims{4, 4}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        OutMat T = row_major(out, 4, 4);
+        fkine(m, ws, ConstVec(in[0], n), T);
+      });
 }
 PyObject* fast_jacobian(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<10, 1>(self, a, f, kw, [](int n) { return Dims{6, n}; },
-                          [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                            OutMat J = row_major(out, 6, n);
-                            jacobian(m, ws, ConstVec(in[0], n), J);
-                          });
+  return fast_call<10, 1>(
+      self, a, f, kw, [](int n) { return Dims{6, n}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        OutMat J = row_major(out, 6, n);
+        jacobian(m, ws, ConstVec(in[0], n), J);
+      });
 }
 PyObject* fast_regressor(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
   // Positional (q, qd, qdd) only: the rigid-body columns (rotor=False, friction=False).
-  return fast_call<11, 3>(self, a, f, kw, [](int n) { return Dims{n, 10 * n}; },
-                          [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                            RowMajorMap Y(out, n, 10 * n);
-                            regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n),
-                                      false, false, Y);
-                          });
+  return fast_call<11, 3>(
+      self, a, f, kw, [](int n) { return Dims{n, 10 * n}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        RowMajorMap Y(out, n, 10 * n);
+        regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), false, false,
+                  Y);
+      });
 }
 PyObject* fast_gravity_regressor(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<12, 1>(self, a, f, kw, [](int n) { return Dims{n, 10 * n}; },
-                          [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                            RowMajorMap Y(out, n, 10 * n);
-                            gravity_regressor(m, ws, ConstVec(in[0], n), Y);
-                          });
+  return fast_call<12, 1>(
+      self, a, f, kw, [](int n) { return Dims{n, 10 * n}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        RowMajorMap Y(out, n, 10 * n);
+        gravity_regressor(m, ws, ConstVec(in[0], n), Y);
+      });
 }
 PyObject* fast_inertia_regressor(PyObject* self, PyObject* const* a, Py_ssize_t f, PyObject* kw) {
-  return fast_call<13, 1>(self, a, f, kw, [](int n) { return Dims{n * (n + 1) / 2, 10 * n}; },
-                          [](const Model& m, Workspace& ws, In in, double* out, int n) {
-                            RowMajorMap Y(out, n * (n + 1) / 2, 10 * n);
-                            inertia_regressor(m, ws, ConstVec(in[0], n), false, Y);
-                          });
+  return fast_call<13, 1>(
+      self, a, f, kw, [](int n) { return Dims{n * (n + 1) / 2, 10 * n}; },
+      [](const Model& m, Workspace& ws, In in, double* out, int n) {
+        RowMajorMap Y(out, n * (n + 1) / 2, 10 * n);
+        inertia_regressor(m, ws, ConstVec(in[0], n), false, Y);
+      });
 }
 
-#define DYNID_FAST(name) \
+#define DYNID_FAST(name)                                                            \
   {#name, reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(fast_##name)), \
    METH_FASTCALL | METH_KEYWORDS, nullptr}
 
 PyMethodDef g_methods[kMethods] = {
-    DYNID_FAST(rnea),           DYNID_FAST(mass_matrix),       DYNID_FAST(gravity),
-    DYNID_FAST(coriolis),       DYNID_FAST(coriolis_matrix),   DYNID_FAST(friction),
-    DYNID_FAST(forward_dynamics), DYNID_FAST(kinetic_energy),  DYNID_FAST(potential_energy),
-    DYNID_FAST(fkine),          DYNID_FAST(jacobian),          DYNID_FAST(regressor),
-    DYNID_FAST(gravity_regressor), DYNID_FAST(inertia_regressor),
+    DYNID_FAST(rnea),
+    DYNID_FAST(mass_matrix),
+    DYNID_FAST(gravity),
+    DYNID_FAST(coriolis),
+    DYNID_FAST(coriolis_matrix),
+    DYNID_FAST(friction),
+    DYNID_FAST(forward_dynamics),
+    DYNID_FAST(kinetic_energy),
+    DYNID_FAST(potential_energy),
+    DYNID_FAST(fkine),
+    DYNID_FAST(jacobian),
+    DYNID_FAST(regressor),
+    DYNID_FAST(gravity_regressor),
+    DYNID_FAST(inertia_regressor),
 };
 #undef DYNID_FAST
 

@@ -23,8 +23,10 @@ struct initialised_caster : pybind11::detail::type_caster_base<T> {
       if (!instance->get_value_and_holder(info, false).holder_constructed()) {
         std::string name = Py_TYPE(src.ptr())->tp_name;  // e.g. dynid._core.Model
         name = name.substr(name.rfind('.') + 1);
-        throw pybind11::type_error(name + " object is not initialised (made by __new__ without "
-                                          "__init__): create it by calling " + name + "(...)");
+        throw pybind11::type_error(name +
+                                   " object is not initialised (made by __new__ without "
+                                   "__init__): create it by calling " +
+                                   name + "(...)");
       }
     }
     return true;

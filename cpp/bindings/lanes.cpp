@@ -26,10 +26,12 @@ void bind_lanes(py::module_& m) {
         Array x = as_real_array(x_arg, "x");
         require_finite(x, "x");
         py::array_t<double> s(x.size()), c(x.size());
-        detail::sincos_many(x.data(), s.mutable_data(), c.mutable_data(), static_cast<int>(x.size()));
+        detail::sincos_many(x.data(), s.mutable_data(), c.mutable_data(),
+                            static_cast<int>(x.size()));
         return py::make_tuple(s, c);
       },
-      py::arg("x"), "sin and cos of the flattened x by the vectorised sincos the kernels use (tests).");
+      py::arg("x"),
+      "sin and cos of the flattened x by the vectorised sincos the kernels use (tests).");
   m.def(
       "_supported_batch_isas",
       [] {

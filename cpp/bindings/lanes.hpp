@@ -7,14 +7,15 @@
 #include <atomic>
 #include <vector>
 
-#include "dynid/detail/batch.hpp"
 #include "batch.hpp"
+#include "dynid/detail/batch.hpp"
 #include "model.hpp"
 
 namespace dynid::binding {
 
 // True when a batch of `s` should use the lane kernels.
-inline bool use_lanes(const PyModel& self, const Samples& s, int max_joints = detail::kMaxBatchJoints) {
+inline bool use_lanes(const PyModel& self, const Samples& s,
+                      int max_joints = detail::kMaxBatchJoints) {
   return !s.single && s.count > 0 && detail::batch_kernels() != nullptr &&
          self.model->n() <= max_joints;
 }
@@ -42,7 +43,8 @@ py::array evaluate_lanes(PyModel& self, const Samples& s, std::vector<py::ssize_
     return [&](py::ssize_t begin, py::ssize_t end) {
       const double* in[3] = {nullptr, nullptr, nullptr};
       for (std::size_t a = 0; a < s.size; ++a) in[a] = s.row(a, begin, n);
-      const long first = kernel(k, bm, in, out_data + begin * per_sample, static_cast<long>(end - begin));
+      const long first =
+          kernel(k, bm, in, out_data + begin * per_sample, static_cast<long>(end - begin));
       if (first >= 0) {
         py::ssize_t seen = first_bad.load();
         const py::ssize_t t = begin + first;

@@ -25,16 +25,17 @@ std::vector<DHRow> parse_dh(py::handle dh_obj, const std::string& joint_types) {
   require_finite(dh, "dh");
   const auto n = static_cast<std::size_t>(dh.shape(0));
   if (joint_types.size() != n)
-    throw py::value_error("joint_types: expected " + std::to_string(n) + " letters (one per DH row), got '" +
-                          joint_types + "'");
+    throw py::value_error("joint_types: expected " + std::to_string(n) +
+                          " letters (one per DH row), got '" + joint_types + "'");
   std::vector<DHRow> rows(n);
   for (std::size_t i = 0; i < n; ++i) {
     const char type = static_cast<char>(std::toupper(static_cast<unsigned char>(joint_types[i])));
     if (type != 'R' && type != 'P')
-      throw py::value_error("joint_types: expected 'R' or 'P', got '" + std::string(1, joint_types[i]) +
-                            "' at position " + std::to_string(i));
+      throw py::value_error("joint_types: expected 'R' or 'P', got '" +
+                            std::string(1, joint_types[i]) + "' at position " + std::to_string(i));
     const double* r = dh.data() + 4 * i;
-    rows[i] = DHRow{r[0], r[1], r[2], r[3], type == 'R' ? JointType::Revolute : JointType::Prismatic};
+    rows[i] =
+        DHRow{r[0], r[1], r[2], r[3], type == 'R' ? JointType::Revolute : JointType::Prismatic};
   }
   return rows;
 }
@@ -84,12 +85,11 @@ void set_batch_threads(int threads) { g_batch_threads.store(threads); }
 
 void bind_model(py::module_& m) {
   m.def(
-      "set_threads",
-      [](py::handle threads) { set_batch_threads(parse_count(threads, "threads")); },
+      "set_threads", [](py::handle threads) { set_batch_threads(parse_count(threads, "threads")); },
       py::arg("threads"),
-        "Use this many threads (each with its own workspace, GIL released) for batch calls of "
-        "at least 512 samples per thread. Default 1. Threads the system refuses (memory, thread "
-        "limit) are skipped: the batch runs on those that start, at least the calling one.");
+      "Use this many threads (each with its own workspace, GIL released) for batch calls of "
+      "at least 512 samples per thread. Default 1. Threads the system refuses (memory, thread "
+      "limit) are skipped: the batch runs on those that start, at least the calling one.");
   m.def("get_threads", &batch_threads, "Threads used by batch calls.");
   m.def(
       "_last_batch_threads", [] { return last_batch_threads.load(); },
@@ -106,30 +106,32 @@ void bind_model(py::module_& m) {
            py::arg("dh"), py::arg("joint_types"), py::arg("convention") = "standard",
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("base") = py::none(),
            py::arg("tool") = py::none())
-      .def_property_readonly("n", [](const PyModel& self) { return self.model->n(); },
-                             "Degrees of freedom.")
+      .def_property_readonly(
+          "n", [](const PyModel& self) { return self.model->n(); }, "Degrees of freedom.")
       .def_property_readonly(
           "dh",
           [](const PyModel& self) {
             std::vector<double> rows;
-            for (const DHRow& r : self.model->dh()) rows.insert(rows.end(), {r.a, r.alpha, r.d, r.theta});
+            for (const DHRow& r : self.model->dh())
+              rows.insert(rows.end(), {r.a, r.alpha, r.d, r.theta});
             return read_only(rows.data(), {self.model->n(), 4});
           },
           "DH table (n, 4), rows [a, alpha, d, theta] as given.")
-      .def_property_readonly(
-          "joint_types",
-          [](const PyModel& self) {
-            std::string types;
-            for (const DHRow& r : self.model->dh()) types += r.type == JointType::Revolute ? 'R' : 'P';
-            return types;
-          })
+      .def_property_readonly("joint_types",
+                             [](const PyModel& self) {
+                               std::string types;
+                               for (const DHRow& r : self.model->dh())
+                                 types += r.type == JointType::Revolute ? 'R' : 'P';
+                               return types;
+                             })
       .def_property_readonly("convention",
                              [](const PyModel& self) {
                                return self.model->convention() == Convention::Standard ? "standard"
-                                                                                        : "modified";
+                                                                                       : "modified";
                              })
       .def_property(
-          "gravity_vector", [](const PyModel& self) { return vector_property(self.model->gravity()); },
+          "gravity_vector",
+          [](const PyModel& self) { return vector_property(self.model->gravity()); },
           [](PyModel& self, py::handle g) {
             const Vector3 v = parse_vector3(g, "gravity");
             self.modify([&](Model& model) { model.set_gravity(v); });
@@ -160,7 +162,8 @@ void bind_model(py::module_& m) {
       .def_property(
           "params",
           [](const PyModel& self) {
-            const Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor> P = self.model->parameters();
+            const Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor> P =
+                self.model->parameters();
             return read_only(P.data(), {self.model->n(), 10});
           },
           [](PyModel& self, py::handle value) {
@@ -172,7 +175,9 @@ void bind_model(py::module_& m) {
               throw py::value_error("params: expected shape (" + std::to_string(n) + ", 10) or (" +
                                     std::to_string(10 * n) + ",), got " + shape_string(a));
             require_finite(a, "params");
-            const MatrixX P = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor>>(a.data(), n, 10);
+            const MatrixX P =
+                Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor>>(
+                    a.data(), n, 10);
             self.modify([&](Model& model) { model.set_parameters(P); });
           },
           "Standard inertial parameters (n, 10): [m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] per "
@@ -202,16 +207,19 @@ void bind_model(py::module_& m) {
           "_set_link_physical",
           [](PyModel& self, int i, double mass, py::handle com, py::handle inertia_com) {
             if (i < 0 || i >= self.model->n())
-              throw py::value_error("i: expected a link index in [0, " + std::to_string(self.model->n()) +
-                                    "), got " + std::to_string(i));
+              throw py::value_error("i: expected a link index in [0, " +
+                                    std::to_string(self.model->n()) + "), got " +
+                                    std::to_string(i));
             if (!std::isfinite(mass)) throw py::value_error("mass: expected a finite number");
             const Vector3 c = parse_vector3(com, "com");
             Array I = parse_fixed(inertia_com, "inertia_com", {3, 3});
-            const Matrix3 Ic = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(I.data());
+            const Matrix3 Ic =
+                Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(I.data());
             const std::string why = physical_inconsistency(mass, Ic);
             if (!why.empty())
-              throw py::value_error(std::string(why.rfind("mass", 0) == 0 ? "mass" : "inertia_com") +
-                                    ": link " + std::to_string(i) + " is not physically possible: " + why);
+              throw py::value_error(
+                  std::string(why.rfind("mass", 0) == 0 ? "mass" : "inertia_com") + ": link " +
+                  std::to_string(i) + " is not physically possible: " + why);
             const RigidBodyParameters body = RigidBodyParameters::from_physical(mass, c, Ic);
             self.modify([&](Model& model) { model.set_link(i, body); });
           },
@@ -226,14 +234,19 @@ void bind_model(py::module_& m) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
             if (use_lanes(self, s))
-              return evaluate_lanes(self, s, {n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                                     const double* const* in, double* out, long T) {
-                return k.rnea(bm, in[0], in[1], in[2], out, T);
-              }, out);
-            return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutVec tau(out, n);
-              rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
-            }, out);
+              return evaluate_lanes(
+                  self, s, {n},
+                  [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                     const double* const* in, double* out,
+                     long T) { return k.rnea(bm, in[0], in[1], in[2], out, T); },
+                  out);
+            return evaluate(
+                self, s, {n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutVec tau(out, n);
+                  rnea(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), tau);
+                },
+                out);
           },
           py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("out") = py::none(),
           "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).")
@@ -243,30 +256,41 @@ void bind_model(py::module_& m) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
             if (use_lanes(self, s))
-              return evaluate_lanes(self, s, {n, n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                                        const double* const* in, double* out, long T) {
-                return k.mass_matrix(bm, in[0], out, T);
-              }, out);
-            return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat M = row_major(out, n, n);
-              crba(m, ws, ConstVec(in[0], n), M);
-            }, out);
+              return evaluate_lanes(
+                  self, s, {n, n},
+                  [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                     const double* const* in, double* out,
+                     long T) { return k.mass_matrix(bm, in[0], out, T); },
+                  out);
+            return evaluate(
+                self, s, {n, n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutMat M = row_major(out, n, n);
+                  crba(m, ws, ConstVec(in[0], n), M);
+                },
+                out);
           },
-          py::arg("q"), py::arg("out") = py::none(), "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).")
+          py::arg("q"), py::arg("out") = py::none(),
+          "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).")
       .def(
           "gravity",
           [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
             if (use_lanes(self, s))
-              return evaluate_lanes(self, s, {n}, [](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                                     const double* const* in, double* out, long T) {
-                return k.gravity(bm, in[0], out, T);
-              }, out);
-            return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutVec g(out, n);
-              gravity(m, ws, ConstVec(in[0], n), g);
-            }, out);
+              return evaluate_lanes(
+                  self, s, {n},
+                  [](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                     const double* const* in, double* out,
+                     long T) { return k.gravity(bm, in[0], out, T); },
+                  out);
+            return evaluate(
+                self, s, {n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutVec g(out, n);
+                  gravity(m, ws, ConstVec(in[0], n), g);
+                },
+                out);
           },
           py::arg("q"), py::arg("out") = py::none(), "Gravity torques g(q).")
       .def(
@@ -274,33 +298,44 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q, py::handle qd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-            return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutVec c(out, n);
-              coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
-            }, out);
+            return evaluate(
+                self, s, {n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutVec c(out, n);
+                  coriolis(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), c);
+                },
+                out);
           },
-          py::arg("q"), py::arg("qd"), py::arg("out") = py::none(), "Coriolis and centrifugal torques c(q, qd).")
+          py::arg("q"), py::arg("qd"), py::arg("out") = py::none(),
+          "Coriolis and centrifugal torques c(q, qd).")
       .def(
           "coriolis_matrix",
           [](PyModel& self, py::handle q, py::handle qd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-            return evaluate(self, s, {n, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat S = row_major(out, n, n);
-              coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
-            }, out);
+            return evaluate(
+                self, s, {n, n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutMat S = row_major(out, n, n);
+                  coriolis_matrix(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), S);
+                },
+                out);
           },
           py::arg("q"), py::arg("qd"), py::arg("out") = py::none(),
-          "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S skew-symmetric.")
+          "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S "
+          "skew-symmetric.")
       .def(
           "friction",
           [](PyModel& self, py::handle qd, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{qd, "qd"}}, n);
-            return evaluate(self, s, {n}, [n](const Model& m, Workspace&, const double* const* in, double* out) {
-              OutVec tau(out, n);
-              friction(m, ConstVec(in[0], n), tau);
-            }, out);
+            return evaluate(
+                self, s, {n},
+                [n](const Model& m, Workspace&, const double* const* in, double* out) {
+                  OutVec tau(out, n);
+                  friction(m, ConstVec(in[0], n), tau);
+                },
+                out);
           },
           py::arg("qd"), py::arg("out") = py::none(), "Joint friction Fv qd + Fs sign(qd).")
       .def(
@@ -309,23 +344,31 @@ void bind_model(py::module_& m) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {tau, "tau"}}, n);
             try {
-              return evaluate(self, s, {n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                OutVec qdd(out, n);
-                forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), qdd);
-              }, out);
+              return evaluate(
+                  self, s, {n},
+                  [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                    OutVec qdd(out, n);
+                    forward_dynamics(m, ws, ConstVec(in[0], n), ConstVec(in[1], n),
+                                     ConstVec(in[2], n), qdd);
+                  },
+                  out);
             } catch (const std::domain_error& e) {
               throw py::value_error(std::string("params: ") + e.what());
             }
           },
-          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("out") = py::none(), "Joint accelerations for the torques tau.")
+          py::arg("q"), py::arg("qd"), py::arg("tau"), py::arg("out") = py::none(),
+          "Joint accelerations for the torques tau.")
       .def(
           "kinetic_energy",
           [](PyModel& self, py::handle q, py::handle qd) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-            return energy(self, s, evaluate(self, s, {}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              *out = kinetic_energy(m, ws, ConstVec(in[0], n), ConstVec(in[1], n));
-            }));
+            return energy(
+                self, s,
+                evaluate(self, s, {},
+                         [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                           *out = kinetic_energy(m, ws, ConstVec(in[0], n), ConstVec(in[1], n));
+                         }));
           },
           py::arg("q"), py::arg("qd"), "Kinetic energy 1/2 qd^T M(q) qd (rotors included).")
       .def(
@@ -333,9 +376,12 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
-            return energy(self, s, evaluate(self, s, {}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              *out = potential_energy(m, ws, ConstVec(in[0], n));
-            }));
+            return energy(
+                self, s,
+                evaluate(self, s, {},
+                         [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                           *out = potential_energy(m, ws, ConstVec(in[0], n));
+                         }));
           },
           py::arg("q"), "Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).")
       .def(
@@ -343,23 +389,31 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(self, s, {4, 4}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat T = row_major(out, 4, 4);
-              fkine(m, ws, ConstVec(in[0], n), T);
-            }, out);
+            return evaluate(
+                self, s, {4, 4},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutMat T = row_major(out, 4, 4);
+                  fkine(m, ws, ConstVec(in[0], n), T);
+                },
+                out);
           },
-          py::arg("q"), py::arg("out") = py::none(), "World pose (4, 4) of the tool: base A_1 ... A_n tool.")
+          py::arg("q"), py::arg("out") = py::none(),
+          "World pose (4, 4) of the tool: base A_1 ... A_n tool.")
       .def(
           "jacobian",
           [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(self, s, {6, n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              OutMat J = row_major(out, 6, n);
-              jacobian(m, ws, ConstVec(in[0], n), J);
-            }, out);
+            return evaluate(
+                self, s, {6, n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  OutMat J = row_major(out, 6, n);
+                  jacobian(m, ws, ConstVec(in[0], n), J);
+                },
+                out);
           },
-          py::arg("q"), py::arg("out") = py::none(), "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
+          py::arg("q"), py::arg("out") = py::none(),
+          "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].")
       .def(
           "regressor",
           [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle rotor_flag,
@@ -373,30 +427,43 @@ void bind_model(py::module_& m) {
                 columns_arg.is_none() ? std::vector<int>() : parse_columns(columns_arg, P);
             const int C = columns.empty() ? P : static_cast<int>(columns.size());
             if (use_lanes(self, s, detail::kMaxRegressorLaneJoints))
-              return evaluate_lanes(self, s, {n, C}, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                                         const double* const* in, double* out, long T) {
-                return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
-                                   columns.empty() ? nullptr : columns.data(), C, out, T);
-              }, out);
+              return evaluate_lanes(
+                  self, s, {n, C},
+                  [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
+                      const double* const* in, double* out, long T) {
+                    return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
+                                       columns.empty() ? nullptr : columns.data(), C, out, T);
+                  },
+                  out);
             if (columns_arg.is_none())
-              return evaluate(self, s, {n, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                RowMajorMap Y(out, n, P);
-                regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor, friction, Y);
-              }, out);
+              return evaluate(
+                  self, s, {n, P},
+                  [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                    RowMajorMap Y(out, n, P);
+                    regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n),
+                              rotor, friction, Y);
+                  },
+                  out);
             // Only the selected columns (e.g. the base parameters'): each sample's full regressor
             // goes to a per-thread buffer in cache and the columns are copied out of it.
-            return evaluate(self, s, {n, C}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              thread_local std::vector<double> full;
-              full.resize(static_cast<std::size_t>(n) * P);
-              RowMajorMap Y(full.data(), n, P);
-              regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor, friction, Y);
-              for (int i = 0; i < n; ++i)
-                for (int k = 0; k < C; ++k) out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
-            }, out);
+            return evaluate(
+                self, s, {n, C},
+                [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  thread_local std::vector<double> full;
+                  full.resize(static_cast<std::size_t>(n) * P);
+                  RowMajorMap Y(full.data(), n, P);
+                  regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n),
+                            rotor, friction, Y);
+                  for (int i = 0; i < n; ++i)
+                    for (int k = 0; k < C; ++k)
+                      out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
+                },
+                out);
           },
-          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false, py::arg("friction") = false,
-          py::arg("columns") = py::none(), py::arg("out") = py::none(),
-          "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; with "
+          py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false,
+          py::arg("friction") = false, py::arg("columns") = py::none(), py::arg("out") = py::none(),
+          "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; "
+          "with "
           "columns (indices into the P columns, e.g. base_parameters(...).independent) only those, "
           "(n, len(columns)); out: a preallocated float64 result array of the exact shape.")
       .def(
@@ -404,12 +471,16 @@ void bind_model(py::module_& m) {
           [](PyModel& self, py::handle q, py::handle out) {
             const int n = self.model->n();
             const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(self, s, {n, 10 * n}, [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              RowMajorMap Y(out, n, 10 * n);
-              gravity_regressor(m, ws, ConstVec(in[0], n), Y);
-            }, out);
+            return evaluate(
+                self, s, {n, 10 * n},
+                [n](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  RowMajorMap Y(out, n, 10 * n);
+                  gravity_regressor(m, ws, ConstVec(in[0], n), Y);
+                },
+                out);
           },
-          py::arg("q"), py::arg("out") = py::none(), "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
+          py::arg("q"), py::arg("out") = py::none(),
+          "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).")
       .def(
           "inertia_regressor",
           [](PyModel& self, py::handle q, py::handle rotor_flag, py::handle out) {
@@ -417,10 +488,13 @@ void bind_model(py::module_& m) {
             const int n = self.model->n();
             const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
             const Samples s = parse_samples({{q, "q"}}, n);
-            return evaluate(self, s, {rows, P}, [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              RowMajorMap Y(out, rows, P);
-              inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
-            }, out);
+            return evaluate(
+                self, s, {rows, P},
+                [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
+                  RowMajorMap Y(out, rows, P);
+                  inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
+                },
+                out);
           },
           py::arg("q"), py::arg("rotor") = false, py::arg("out") = py::none(),
           "Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] "

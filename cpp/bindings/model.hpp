@@ -22,7 +22,8 @@ struct PyModel {
   std::unique_ptr<Workspace> ws;
 
   explicit PyModel(Model m)
-      : model(std::make_shared<const Model>(std::move(m))), ws(std::make_unique<Workspace>(*model)) {}
+      : model(std::make_shared<const Model>(std::move(m))),
+        ws(std::make_unique<Workspace>(*model)) {}
 
   template <class Change>
   void modify(Change change) {
@@ -80,7 +81,8 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
     const double* in[Samples::kMaxArguments] = {};
     for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
-    if (!all_finite(out_data, per_sample)) require_finite_result(out_data, per_sample, s.names.c_str());
+    if (!all_finite(out_data, per_sample))
+      require_finite_result(out_data, per_sample, s.names.c_str());
     return out;
   }
   std::shared_ptr<const Model> model = self.model;

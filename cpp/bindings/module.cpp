@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "elastic.hpp"
-#include "lanes.hpp"
 #include "fast_calls.hpp"
+#include "lanes.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 #include "simulator.hpp"

@@ -31,7 +31,6 @@ std::string shape_of(std::initializer_list<py::ssize_t> dims) {
   return s + (dims.size() == 1 ? ",)" : ")");
 }
 
-
 // The core names the C++ arguments (P0); the Python user passed initial_covariance.
 template <class Call>
 void with_python_names(Call call) {
@@ -179,17 +178,20 @@ py::array update_batch(RLS& rls, py::handle Y_obj, py::handle tau_obj, py::handl
   // An interrupted or overflowing batch leaves the estimator as it was before the call.
   const RLS before = rls;
   try {
-    run_batch(T, 1, [&] {
-      return [&](py::ssize_t begin, py::ssize_t end) {
-        for (py::ssize_t t = begin; t < end; ++t) {
-          rls.update(block(Y_data + t * m * p, m, p),
-                     Eigen::Map<const VectorX>(tau_data + t * m, m));
-          if (history)
-            std::memcpy(out + t * p, rls.theta().data(),
-                        sizeof(double) * static_cast<std::size_t>(p));
-        }
-      };
-    }, chunk_for_work(static_cast<double>(m) * p * p, 4e6));
+    run_batch(
+        T, 1,
+        [&] {
+          return [&](py::ssize_t begin, py::ssize_t end) {
+            for (py::ssize_t t = begin; t < end; ++t) {
+              rls.update(block(Y_data + t * m * p, m, p),
+                         Eigen::Map<const VectorX>(tau_data + t * m, m));
+              if (history)
+                std::memcpy(out + t * p, rls.theta().data(),
+                            sizeof(double) * static_cast<std::size_t>(p));
+            }
+          };
+        },
+        chunk_for_work(static_cast<double>(m) * p * p, 4e6));
   } catch (...) {
     rls = before;
     throw;

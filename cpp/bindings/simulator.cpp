@@ -138,11 +138,10 @@ void bind_simulator(py::module_& m) {
         const auto cols = static_cast<py::ssize_t>(n);
         py::array_t<double> q({rows, cols}), qd({rows, cols}), qdd({rows, cols}), tau({rows, cols});
         py::array_t<double> q_measured({record_measured ? rows : py::ssize_t{0}, cols});
-        SimulationOutput out{RowMajorMap(q.mutable_data(), rows, n),
-                             RowMajorMap(qd.mutable_data(), rows, n),
-                             RowMajorMap(qdd.mutable_data(), rows, n),
-                             RowMajorMap(tau.mutable_data(), rows, n),
-                             RowMajorMap(q_measured.mutable_data(), q_measured.shape(0), n)};
+        SimulationOutput out{
+            RowMajorMap(q.mutable_data(), rows, n), RowMajorMap(qd.mutable_data(), rows, n),
+            RowMajorMap(qdd.mutable_data(), rows, n), RowMajorMap(tau.mutable_data(), rows, n),
+            RowMajorMap(q_measured.mutable_data(), q_measured.shape(0), n)};
         Interruptible interruptible(*controller);
         {
           py::gil_scoped_release release;

@@ -24,7 +24,8 @@ VectorX parse_gain(py::handle obj, int n) {
     throw py::value_error("gain: expected a number or shape (" + std::to_string(n) + ",), got " +
                           shape_string(a));
   require_finite(a, "gain");
-  const VectorX gain = a.ndim() == 0 ? VectorX::Constant(n, a.data()[0]) : VectorX(ConstVec(a.data(), n));
+  const VectorX gain =
+      a.ndim() == 0 ? VectorX::Constant(n, a.data()[0]) : VectorX(ConstVec(a.data(), n));
   if (!(gain.minCoeff() > 0.0))
     throw py::value_error("gain: expected values > 0 (1/s), got a minimum of " +
                           std::to_string(gain.minCoeff()));
@@ -47,12 +48,19 @@ void bind_uses(py::module_& m) {
         const int n = self.model->n();
         const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
         // Both matrices of a sample side by side: out[..., 0, :, :] = dtau/dq, [..., 1] = dtau/dqd.
-        py::array both = evaluate(self, s, {2, n, n}, [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
-          OutMat dq = row_major(out, n, n), dqd = row_major(out + n * n, n, n);
-          rnea_derivatives(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), dq, dqd);
-        });
-        py::object index0 = s.single ? py::object(py::int_(0)) : py::object(py::make_tuple(py::ellipsis(), 0, py::slice(), py::slice()));
-        py::object index1 = s.single ? py::object(py::int_(1)) : py::object(py::make_tuple(py::ellipsis(), 1, py::slice(), py::slice()));
+        py::array both =
+            evaluate(self, s, {2, n, n},
+                     [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
+                       OutMat dq = row_major(out, n, n), dqd = row_major(out + n * n, n, n);
+                       rnea_derivatives(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n),
+                                        ConstVec(in[2], n), dq, dqd);
+                     });
+        py::object index0 =
+            s.single ? py::object(py::int_(0))
+                     : py::object(py::make_tuple(py::ellipsis(), 0, py::slice(), py::slice()));
+        py::object index1 =
+            s.single ? py::object(py::int_(1))
+                     : py::object(py::make_tuple(py::ellipsis(), 1, py::slice(), py::slice()));
         // py::array, not the item accessors: pybind11 puts the C++ type names in the signature.
         return py::make_tuple(py::array(both[index0]), py::array(both[index1]));
       },
@@ -65,10 +73,11 @@ void bind_uses(py::module_& m) {
       [](PyModel& self, py::handle q, py::handle qd) {
         const int n = self.model->n();
         const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-        return evaluate(self, s, {6, n}, [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
-          OutMat Jdot = row_major(out, 6, n);
-          jacobian_dot(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n), Jdot);
-        });
+        return evaluate(self, s, {6, n},
+                        [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
+                          OutMat Jdot = row_major(out, 6, n);
+                          jacobian_dot(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n), Jdot);
+                        });
       },
       py::arg("q"), py::arg("qd"),
       "Time derivative (6, n) of jacobian(q) along qd: tool point, world axes, rows [v; omega].");
@@ -86,31 +95,41 @@ Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample 
       .def(py::init([](PyModel& robot, py::handle gain, py::handle dt) {
              const double period = parse_number(dt, "dt");
              if (!std::isfinite(period) || !(period > 0.0))
-               throw py::value_error("dt: expected a finite sample period > 0 (s), got " + std::string(py::repr(dt)));
+               throw py::value_error("dt: expected a finite sample period > 0 (s), got " +
+                                     std::string(py::repr(dt)));
              const VectorX K = parse_gain(gain, robot.model->n());
              return PyMomentumObserver{std::make_unique<MomentumObserver>(*robot.model, K, period)};
            }),
            py::arg("robot"), py::arg("gain"), py::arg("dt"))
-      .def_property_readonly("n", [](const PyMomentumObserver& self) { return self.observer->model().n(); })
-      .def_property_readonly("gain", [](const PyMomentumObserver& self) { return vector_copy(self.observer->gain()); },
-                             "K_O per joint (n,), 1/s.")
-      .def_property_readonly("dt", [](const PyMomentumObserver& self) { return self.observer->dt(); })
-      .def_property_readonly("residual", [](const PyMomentumObserver& self) { return vector_copy(self.observer->residual()); },
-                             "The last residual r (n,).")
-      .def_property_readonly("samples", [](const PyMomentumObserver& self) { return self.observer->samples(); },
-                             "Samples seen since construction or reset().")
-      .def("reset", [](PyMomentumObserver& self) { self.observer->reset(); },
-           "Forget the history: the next sample starts a new integral (r = 0, p(0) = M q̇).")
+      .def_property_readonly(
+          "n", [](const PyMomentumObserver& self) { return self.observer->model().n(); })
+      .def_property_readonly(
+          "gain", [](const PyMomentumObserver& self) { return vector_copy(self.observer->gain()); },
+          "K_O per joint (n,), 1/s.")
+      .def_property_readonly("dt",
+                             [](const PyMomentumObserver& self) { return self.observer->dt(); })
+      .def_property_readonly(
+          "residual",
+          [](const PyMomentumObserver& self) { return vector_copy(self.observer->residual()); },
+          "The last residual r (n,).")
+      .def_property_readonly(
+          "samples", [](const PyMomentumObserver& self) { return self.observer->samples(); },
+          "Samples seen since construction or reset().")
+      .def(
+          "reset", [](PyMomentumObserver& self) { self.observer->reset(); },
+          "Forget the history: the next sample starts a new integral (r = 0, p(0) = M q̇).")
       .def(
           "update",
           [](PyMomentumObserver& self, py::handle q, py::handle qd, py::handle tau) {
             const int n = self.observer->model().n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {tau, "tau"}}, n);
             if (!s.single)
-              throw py::value_error("q: expected shape (" + std::to_string(n) + ",) (one sample; run() takes a log)");
+              throw py::value_error("q: expected shape (" + std::to_string(n) +
+                                    ",) (one sample; run() takes a log)");
             py::array_t<double> r(n);
             OutVec out(r.mutable_data(), n);
-            self.observer->update(ConstVec(s.row(0, 0, n), n), ConstVec(s.row(1, 0, n), n), ConstVec(s.row(2, 0, n), n), out);
+            self.observer->update(ConstVec(s.row(0, 0, n), n), ConstVec(s.row(1, 0, n), n),
+                                  ConstVec(s.row(2, 0, n), n), out);
             require_finite_result(r.data(), n, s.names.c_str());
             return r;
           },
@@ -122,21 +141,24 @@ Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample 
             const int n = self.observer->model().n();
             const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {tau, "tau"}}, n);
             if (s.single)
-              throw py::value_error("q: expected shape (T, " + std::to_string(n) + ") (a log; update() takes one sample)");
+              throw py::value_error("q: expected shape (T, " + std::to_string(n) +
+                                    ") (a log; update() takes one sample)");
             py::array_t<double> r({s.count, static_cast<py::ssize_t>(n)});
             double* data = r.mutable_data();
             {
               py::gil_scoped_release release;
               for (py::ssize_t t = 0; t < s.count; ++t) {
                 OutVec out(data + t * n, n);
-                self.observer->update(ConstVec(s.row(0, t, n), n), ConstVec(s.row(1, t, n), n), ConstVec(s.row(2, t, n), n), out);
+                self.observer->update(ConstVec(s.row(0, t, n), n), ConstVec(s.row(1, t, n), n),
+                                      ConstVec(s.row(2, t, n), n), out);
               }
             }
             require_finite_result(data, s.count * n, s.names.c_str());
             return r;
           },
           py::arg("q"), py::arg("qd"), py::arg("tau"),
-          "The residual (T, n) over a log (T, n) each, sample by sample in C++ with the GIL released, "
+          "The residual (T, n) over a log (T, n) each, sample by sample in C++ with the GIL "
+          "released, "
           "continuing from the current state (call reset() first for a new log).");
 }
 

@@ -12,9 +12,9 @@
 //
 // Every global operator new / new[] (plain, nothrow, aligned, aligned nothrow) is replaced, and
 // every operator delete form with it. Eigen does not use operator new for its dynamic matrices: it
-// calls std::malloc (aligned_malloc). On glibc, malloc and its relatives are therefore replaced too,
-// forwarding to glibc's own __libc_* entry points, so that an Eigen temporary in the loop would be
-// counted as well. The program is single-threaded, so plain variables suffice.
+// calls std::malloc (aligned_malloc). On glibc, malloc and its relatives are therefore replaced
+// too, forwarding to glibc's own __libc_* entry points, so that an Eigen temporary in the loop
+// would be counted as well. The program is single-threaded, so plain variables suffice.
 
 namespace {
 bool counting = false;
@@ -37,8 +37,9 @@ inline void count() {
 
 #if defined(DYNID_COUNT_WITH_SANITIZER_HOOK)
 // From <sanitizer/allocator_interface.h>, declared here: not every compiler installs that header.
-extern "C" int __sanitizer_install_malloc_and_free_hooks(
-    void (*malloc_hook)(const volatile void*, std::size_t), void (*free_hook)(const volatile void*));
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*,
+                                                                             std::size_t),
+                                                         void (*free_hook)(const volatile void*));
 
 namespace {
 void count_allocation_hook(const volatile void*, std::size_t) { count(); }
@@ -132,9 +133,7 @@ void operator delete[](void* p, std::size_t) noexcept { RAW_FREE(p); }
 void operator delete(void* p, std::align_val_t) noexcept { RAW_FREE(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { RAW_FREE(p); }
 void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { RAW_FREE(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
-  RAW_FREE(p);
-}
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { RAW_FREE(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { RAW_FREE(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { RAW_FREE(p); }
 

@@ -280,29 +280,35 @@ int main(int argc, char** argv) {
   std::vector<double> sorted = t_cycle;
   std::sort(sorted.begin(), sorted.end());
   const double p99 = sorted[std::min<std::size_t>(sorted.size() - 1, sorted.size() * 99 / 100)];
-  const long overruns = std::count_if(t_cycle.begin(), t_cycle.end(),
-                                      [](double us) { return us > 1e6 * kPeriod; });
+  const long overruns =
+      std::count_if(t_cycle.begin(), t_cycle.end(), [](double us) { return us > 1e6 * kPeriod; });
   const double prediction_error = std::sqrt(prediction_error_sq / torque_sq);
   const double parameter_error = (rls.theta() - pi_true).norm() / pi_true.norm();
 
-  std::printf("dynid real-time loop: KUKA LWR-IV, n = %d, %d regressor columns, 1 kHz, "
-              "%.3g s simulated (%ld cycles)\n", n, P, seconds, cycles);
+  std::printf(
+      "dynid real-time loop: KUKA LWR-IV, n = %d, %d regressor columns, 1 kHz, "
+      "%.3g s simulated (%ld cycles)\n",
+      n, P, seconds, cycles);
   std::printf("allocations: %ld allocations in %ld cycles (operator new and malloc counted)\n",
               loop_allocations, cycles);
-  std::printf("cycle time [us]: median %.2f, 99th percentile %.2f, max %.2f (cycle %ld); "
-              "medians: rnea %.2f, regressor %.2f, RLS update %.2f, momentum observer %.2f; %ld "
-              "cycles over the %.0f us period\n",
-              median(t_cycle), p99, *slowest, static_cast<long>(slowest - t_cycle.begin()),
-              median(t_rnea), median(t_regressor), median(t_rls), median(t_observer), overruns,
-              1e6 * kPeriod);
+  std::printf(
+      "cycle time [us]: median %.2f, 99th percentile %.2f, max %.2f (cycle %ld); "
+      "medians: rnea %.2f, regressor %.2f, RLS update %.2f, momentum observer %.2f; %ld "
+      "cycles over the %.0f us period\n",
+      median(t_cycle), p99, *slowest, static_cast<long>(slowest - t_cycle.begin()), median(t_rnea),
+      median(t_regressor), median(t_rls), median(t_observer), overruns, 1e6 * kPeriod);
   std::printf("max |rnea - (M qdd + S qd + g + friction)| = %.3e N m\n", max_dynamics_error);
   std::printf("max |Y pi - rnea| = %.3e N m\n", max_regressor_error);
   std::printf("max |forward_dynamics(rnea) - qdd| = %.3e rad/s^2\n", max_forward_error);
   std::printf("max |collision residual| without contact = %.3e N m\n", max_residual);
-  std::printf("torque prediction error of the RLS estimate (a priori, last 10%% of the cycles): "
-              "%.3e relative RMS\n", prediction_error);
-  std::printf("standard-parameter error |theta - pi| / |pi| = %.3e (not all identifiable: only "
-              "their base combinations are)\n", parameter_error);
+  std::printf(
+      "torque prediction error of the RLS estimate (a priori, last 10%% of the cycles): "
+      "%.3e relative RMS\n",
+      prediction_error);
+  std::printf(
+      "standard-parameter error |theta - pi| / |pi| = %.3e (not all identifiable: only "
+      "their base combinations are)\n",
+      parameter_error);
 
   if (loop_allocations != 0) return 1;
   if (!(max_dynamics_error < 1e-9) || !(max_regressor_error < 1e-9) ||

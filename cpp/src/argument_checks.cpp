@@ -14,11 +14,10 @@ void throw_wrong_size(const char* function, const char* argument, Eigen::Index s
 
 void throw_wrong_shape(const char* function, const char* argument, Eigen::Index rows,
                        Eigen::Index cols, Eigen::Index expected_rows, Eigen::Index expected_cols) {
-  throw std::invalid_argument(std::string(argument) + ": expected a " +
-                              std::to_string(expected_rows) + " x " +
-                              std::to_string(expected_cols) + " matrix, got " +
-                              std::to_string(rows) + " x " + std::to_string(cols) +
-                              " (in dynid::" + function + ")");
+  throw std::invalid_argument(
+      std::string(argument) + ": expected a " + std::to_string(expected_rows) + " x " +
+      std::to_string(expected_cols) + " matrix, got " + std::to_string(rows) + " x " +
+      std::to_string(cols) + " (in dynid::" + function + ")");
 }
 
 void throw_wrong_workspace(const char* function, int workspace_joints, int model_joints) {

@@ -97,10 +97,17 @@ BatchModel batch_model(const Model& model, std::vector<BatchJoint>& joints) {
   for (int i = 0; i < n; ++i) {
     const JointGeometry& g = model.joint(i);
     const RigidBodyParameters& b = model.body(i);
-    joints[i] = BatchJoint{g.cos_alpha, g.sin_alpha, g.a, g.theta, g.d, g.revolute ? 1 : 0,
-                           b.m, {b.h.x(), b.h.y(), b.h.z()},
+    joints[i] = BatchJoint{g.cos_alpha,
+                           g.sin_alpha,
+                           g.a,
+                           g.theta,
+                           g.d,
+                           g.revolute ? 1 : 0,
+                           b.m,
+                           {b.h.x(), b.h.y(), b.h.z()},
                            {b.I(0, 0), b.I(0, 1), b.I(0, 2), b.I(1, 1), b.I(1, 2), b.I(2, 2)},
-                           model.rotor_inertia()[i], model.viscous_friction()[i],
+                           model.rotor_inertia()[i],
+                           model.viscous_friction()[i],
                            model.coulomb_friction()[i]};
     const LinkOffset& o = model.link_offset(i);
     joints[i].offset_identity = o.identity ? 1 : 0;

@@ -7,7 +7,10 @@
 #include "batch/lane_regressor.hpp"
 
 namespace dynid::detail {
-const LaneKernels lanes_sse2 = {"sse2", 2, &lanes_sse2_impl::rnea, &lanes_sse2_impl::gravity,
+const LaneKernels lanes_sse2 = {"sse2",
+                                2,
+                                &lanes_sse2_impl::rnea,
+                                &lanes_sse2_impl::gravity,
                                 &lanes_sse2_impl::mass_matrix,
                                 &lanes_sse2_impl::regressor,
                                 &lanes_sse2_impl::sincos_many};

@@ -56,8 +56,8 @@ void PDController::command(int k, double, const VectorIn& q, const VectorIn& qd,
   tau = kp_.cwiseProduct(e_) + kd_.cwiseProduct(ed_);
 }
 
-PDGravityController::PDGravityController(const Model& model, const VectorIn& kp,
-                                         const VectorIn& kd, const ReferenceTrajectory& reference)
+PDGravityController::PDGravityController(const Model& model, const VectorIn& kp, const VectorIn& kd,
+                                         const ReferenceTrajectory& reference)
     : PDController(kp, kd, reference), model_(model), ws_(model), g_(kp.size()) {
   check_model(model, kp.size());
 }
@@ -81,8 +81,8 @@ void ComputedTorqueController::command(int k, double, const VectorIn& q, const V
   errors(k, q, qd, tau.size());
   const int n = reference_.n;
   // The outer loop's acceleration command, then inverse dynamics of the model at (q, qd, v).
-  v_ = ConstRow(reference_.qdd + static_cast<std::ptrdiff_t>(k) * n, n) +
-       kd_.cwiseProduct(ed_) + kp_.cwiseProduct(e_);
+  v_ = ConstRow(reference_.qdd + static_cast<std::ptrdiff_t>(k) * n, n) + kd_.cwiseProduct(ed_) +
+       kp_.cwiseProduct(e_);
   rnea(model_, ws_, q, qd, v_, tau);
 }
 

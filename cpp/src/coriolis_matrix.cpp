@@ -1,7 +1,8 @@
 // Christoffel-consistent Coriolis matrix without differentiating M (Echeandia & Wensing, "A
 // numerical method for computing the Coriolis matrix and Christoffel symbols for rigid-body
 // systems", 2021). With world-frame spatial quantities ([angular; linear] about the world origin):
-//   S = sum_i J_i^T (B_i J_i + I_i Jdot_i),  B_i = 1/2 [ (v_i x*) I_i - I_i (v_i x) + (I_i v_i) xbar ]
+//   S = sum_i J_i^T (B_i J_i + I_i Jdot_i),  B_i = 1/2 [ (v_i x*) I_i - I_i (v_i x) + (I_i v_i)
+//   xbar ]
 // where J_i's columns are the joint axes S_k (k <= i), Jdot_i's are Sdot_k = v_k x S_k and
 // (f xbar) m = m x* f. Because body i only involves joints k <= i, entry (j, k) needs only the
 // sums of B_i and I_i over the links outboard of max(j, k).
@@ -47,7 +48,8 @@ void coriolis_matrix(const Model& model, Workspace& workspace, const VectorIn& q
     Matrix3 A;
     for (int c = 0; c < 3; ++c) A.col(c) = w.cross(b.I.col(c));
     const Matrix3 hu = b.h * u.transpose();
-    ws.coriolis_block_sum[i] = 0.5 * (A + A.transpose() - hu - hu.transpose() - skew(angular_momentum));
+    ws.coriolis_block_sum[i] =
+        0.5 * (A + A.transpose() - hu - hu.transpose() - skew(angular_momentum));
     ws.coriolis_block_sum[i].diagonal().array() += u.dot(b.h);
     ws.momentum_sum[i] = linear_momentum;
     ws.inertia_sum[i] = b;

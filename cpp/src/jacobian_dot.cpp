@@ -9,9 +9,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "dynid/detail/spatial.hpp"
 #include "dynid/detail/argument_checks.hpp"
 #include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/spatial.hpp"
 
 namespace dynid {
 

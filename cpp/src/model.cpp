@@ -107,8 +107,8 @@ void Model::update_frames() {
 
 void Model::set_parameters(const Eigen::Ref<const MatrixX>& parameters) {
   if (parameters.rows() != n_ || parameters.cols() != 10)
-    throw std::invalid_argument("params: expected shape (" + std::to_string(n_) +
-                                ", 10), got (" + std::to_string(parameters.rows()) + ", " +
+    throw std::invalid_argument("params: expected shape (" + std::to_string(n_) + ", 10), got (" +
+                                std::to_string(parameters.rows()) + ", " +
                                 std::to_string(parameters.cols()) + ")");
   if (!parameters.allFinite()) throw std::invalid_argument("params: non-finite value");
   parameters_ = parameters;

@@ -205,8 +205,8 @@ RecursiveLeastSquares RecursiveLeastSquares::from_state(const State& state) {
   RecursiveLeastSquares rls(static_cast<int>(p), state.forgetting);
   const auto check = [p](bool ok, const char* name) {
     if (!ok)
-      throw std::invalid_argument(std::string("state.") + name + ": expected " +
-                                  std::to_string(p) + " entries (p x p for U), finite");
+      throw std::invalid_argument(std::string("state.") + name + ": expected " + std::to_string(p) +
+                                  " entries (p x p for U), finite");
   };
   check(state.theta0.size() == p && state.theta0.allFinite(), "theta0");
   check(state.theta.allFinite(), "theta");

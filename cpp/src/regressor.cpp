@@ -63,9 +63,9 @@ struct BodyMap {
     const double xx = w.x() * w.x(), yy = w.y() * w.y(), zz = w.z() * w.z();
     const double xy = w.x() * w.y(), xz = w.x() * w.z(), yz = w.y() * w.z();
     a[0] = k.a.x(), a[1] = k.a.y(), a[2] = k.a.z();
-    const double W_[9] = {-yy - zz,     xy + wd.z(), xz - wd.y(),  //
-                          xy - wd.z(),  -xx - zz,    yz + wd.x(),  //
-                          xz + wd.y(),  yz - wd.x(), -xx - yy};
+    const double W_[9] = {-yy - zz,    xy + wd.z(), xz - wd.y(),  //
+                          xy - wd.z(), -xx - zz,    yz + wd.x(),  //
+                          xz + wd.y(), yz - wd.x(), -xx - yy};
     // Q(wd) minus Q(w) w^, entry by entry.
     const double G_[18] = {wd.x(),      xz,          -xy,          //
                            wd.y() - xz, wd.x() + yz, xx - yy,      //
@@ -91,7 +91,8 @@ struct BodyMap {
 // DH, J_j for modified DH), so that each 1 x 10 block reads them directly.
 //   modified: L_{j-1} -> L_j is the whole joint transform X[j];
 //   standard: F_{j-1} -> J_j is only Rz(theta_j) Tz(d_j) (X[j]'s constant part Rx Tx is link
-//             j-1's offset, already applied), then J_j -> F_j is link j's offset Tx(a_j) Rx(alpha_j).
+//             j-1's offset, already applied), then J_j -> F_j is link j's offset Tx(a_j)
+//             Rx(alpha_j).
 inline void axis_to_child(const JointTransform& X, Vector6& U) {
   // Reference point to O_j (l + s x p), then R^T = Rz(-theta) Rx(-alpha) on both parts.
   const Vector3 s = U.head<3>();

@@ -76,7 +76,8 @@ std::string physical_inconsistency(double mass, const Matrix3& inertia_com) {
   const Vector3 moments = Eigen::SelfAdjointEigenSolver<Matrix3>(inertia_com).eigenvalues();
   if (!(moments.minCoeff() > 0.0))
     return "inertia about the centre of mass must be positive definite (smallest principal "
-           "moment " + std::to_string(moments.minCoeff()) + ")";
+           "moment " +
+           std::to_string(moments.minCoeff()) + ")";
   const double slack = 1e-12 * moments.sum();
   for (int k = 0; k < 3; ++k) {
     if (moments[(k + 1) % 3] + moments[(k + 2) % 3] < moments[k] - slack)

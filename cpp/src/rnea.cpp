@@ -11,8 +11,8 @@
 namespace dynid {
 namespace detail {
 
-void propagate_motion(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd, const VectorIn& qdd,
-                      const Vector3& base_acceleration) {
+void propagate_motion(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd,
+                      const VectorIn& qdd, const Vector3& base_acceleration) {
   const Vector3 z = Vector3::UnitZ();
   ws.omega[0].setZero();
   ws.omegad[0].setZero();
@@ -20,8 +20,7 @@ void propagate_motion(const Model& model, WorkspaceBuffers& ws, const VectorIn& 
   for (int i = 1; i <= ws.n; ++i) {
     const JointTransform& X = ws.X[i];
     const Vector3& w = ws.omega[i - 1];
-    const Vector3 origin_acc =
-        ws.a[i - 1] + ws.omegad[i - 1].cross(X.p) + w.cross(w.cross(X.p));
+    const Vector3 origin_acc = ws.a[i - 1] + ws.omegad[i - 1].cross(X.p) + w.cross(w.cross(X.p));
     const Vector3 w_in_i = X.rotate_to_child(w);
     const Vector3 wd_in_i = X.rotate_to_child(ws.omegad[i - 1]);
     const double qdi = qd[i - 1], qddi = qdd[i - 1];
@@ -74,7 +73,8 @@ void rnea(const Model& model, Workspace& workspace, const VectorIn& q, const Vec
   detail::update_joint_transforms(model, ws, q);
   detail::newton_euler(model, ws, qd, qdd, -model.gravity_base(), tau);
   const VectorX& Ia = model.rotor_inertia();
-  for (int i = 0; i < ws.n; ++i) tau[i] += Ia[i] * qdd[i] + detail::friction_torque(model, i, qd[i]);
+  for (int i = 0; i < ws.n; ++i)
+    tau[i] += Ia[i] * qdd[i] + detail::friction_torque(model, i, qd[i]);
 }
 
 }  // namespace dynid

@@ -23,17 +23,16 @@
 #include <stdexcept>
 #include <string>
 
-#include "dynid/detail/spatial.hpp"
 #include "dynid/detail/argument_checks.hpp"
 #include "dynid/detail/kinematics.hpp"
+#include "dynid/detail/spatial.hpp"
 
 namespace dynid {
-namespace {
+namespace {}  // namespace
 
-}  // namespace
-
-void rnea_derivatives(const Model& model, Workspace& workspace, const VectorIn& q, const VectorIn& qd,
-                      const VectorIn& qdd, MatrixOut dtau_dq, MatrixOut dtau_dqd) {
+void rnea_derivatives(const Model& model, Workspace& workspace, const VectorIn& q,
+                      const VectorIn& qd, const VectorIn& qdd, MatrixOut dtau_dq,
+                      MatrixOut dtau_dqd) {
   using detail::force_cross;
   using detail::inertia_times;
   using detail::motion_cross;
@@ -63,7 +62,8 @@ void rnea_derivatives(const Model& model, Workspace& workspace, const VectorIn& 
     v += S * qd[i - 1];
     a += S * qdd[i - 1] + d.dVdq[i] * qd[i - 1];  // v_i x S_i = v_{i-1} x S_i
 
-    const RigidBodyParameters b = model.body(i - 1).expressed_in_parent(ws.R_world[i], ws.p_world[i]);
+    const RigidBodyParameters b =
+        model.body(i - 1).expressed_in_parent(ws.R_world[i], ws.p_world[i]);
     const Vector6 momentum = inertia_times(b, v);  // [angular n; linear p]
     d.force[i] = inertia_times(b, a) + force_cross(v, momentum);
     // D = [[T, 0], [-P^, 0]]: T = A + A^T - (h u^T + u h^T) + 2 (u.h) E - n^, A = w^ I,

@@ -140,14 +140,13 @@ void Simulator::measure(int k) {
 void Simulator::run(Controller& controller, const VectorIn& q0, const VectorIn& qd0, int periods,
                     SimulationOutput& out) {
   const int n = plant_.n();
-  require(q0.size() == n,
-          [&] { return "q0: expected " + std::to_string(n) + " values, got " +
-                              std::to_string(q0.size()); });
-  require(qd0.size() == n,
-          [&] { return "qd0: expected " + std::to_string(n) + " values, got " +
-                               std::to_string(qd0.size()); });
-  require(periods >= 1,
-          [&] { return "periods: expected >= 1, got " + std::to_string(periods); });
+  require(q0.size() == n, [&] {
+    return "q0: expected " + std::to_string(n) + " values, got " + std::to_string(q0.size());
+  });
+  require(qd0.size() == n, [&] {
+    return "qd0: expected " + std::to_string(n) + " values, got " + std::to_string(qd0.size());
+  });
+  require(periods >= 1, [&] { return "periods: expected >= 1, got " + std::to_string(periods); });
   const Eigen::Index rows = static_cast<Eigen::Index>(periods) + 1;
   check_rows(out.q, rows, n, "q");
   check_rows(out.qd, rows, n, "qd");
@@ -167,8 +166,8 @@ void Simulator::run(Controller& controller, const VectorIn& q0, const VectorIn& 
     measure(k);
     controller.command(k, t, q_meas_, qd_meas_, tau_);
     if (!tau_.allFinite())
-      throw std::runtime_error("controller: returned a non-finite torque at t = " +
-                               std::to_string(t) + " s");
+      throw std::runtime_error(
+          "controller: returned a non-finite torque at t = " + std::to_string(t) + " s");
     tau_applied_ = tau_;
     if (settings_.torque_noise > 0.0)
       for (int i = 0; i < n; ++i) tau_applied_[i] += settings_.torque_noise * normal_(rng_);

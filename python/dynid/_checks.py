@@ -70,9 +70,7 @@ def real_array(
         )
     array = array.astype(np.float64, copy=False)
     if ndim is not None and array.ndim != ndim:
-        raise ValueError(
-            f"{name}: expected a {ndim}-dimensional array, got shape {array.shape}"
-        )
+        raise ValueError(f"{name}: expected a {ndim}-dimensional array, got shape {array.shape}")
     if finite:
         check_finite(array, name)
     return array

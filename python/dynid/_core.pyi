@@ -24,98 +24,98 @@ __all__: list[str] = [
 
 class Model:
     @staticmethod
-    def _coriolis_full(*args, **kwargs):
+    def _coriolis_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         coriolis(self: dynid._core.Model, q: object, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Coriolis and centrifugal torques c(q, qd).
         """
     @staticmethod
-    def _coriolis_matrix_full(*args, **kwargs):
+    def _coriolis_matrix_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         coriolis_matrix(self: dynid._core.Model, q: object, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S skew-symmetric.
         """
     @staticmethod
-    def _fkine_full(*args, **kwargs):
+    def _fkine_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         fkine(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         World pose (4, 4) of the tool: base A_1 ... A_n tool.
         """
     @staticmethod
-    def _forward_dynamics_full(*args, **kwargs):
+    def _forward_dynamics_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         forward_dynamics(self: dynid._core.Model, q: object, qd: object, tau: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Joint accelerations for the torques tau.
         """
     @staticmethod
-    def _friction_full(*args, **kwargs):
+    def _friction_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         friction(self: dynid._core.Model, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Joint friction Fv qd + Fs sign(qd).
         """
     @staticmethod
-    def _gravity_full(*args, **kwargs):
+    def _gravity_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         gravity(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Gravity torques g(q).
         """
     @staticmethod
-    def _gravity_regressor_full(*args, **kwargs):
+    def _gravity_regressor_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         gravity_regressor(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).
         """
     @staticmethod
-    def _inertia_regressor_full(*args, **kwargs):
+    def _inertia_regressor_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         inertia_regressor(self: dynid._core.Model, q: object, rotor: object = False, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] (links only, or with the rotor columns the full M) (paper eq. (18)).
         """
     @staticmethod
-    def _jacobian_full(*args, **kwargs):
+    def _jacobian_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         jacobian(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].
         """
     @staticmethod
-    def _kinetic_energy_full(*args, **kwargs):
+    def _kinetic_energy_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         kinetic_energy(self: dynid._core.Model, q: object, qd: object) -> object
 
         Kinetic energy 1/2 qd^T M(q) qd (rotors included).
         """
     @staticmethod
-    def _mass_matrix_full(*args, **kwargs):
+    def _mass_matrix_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         mass_matrix(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).
         """
     @staticmethod
-    def _potential_energy_full(*args, **kwargs):
+    def _potential_energy_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         potential_energy(self: dynid._core.Model, q: object) -> object
 
         Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).
         """
     @staticmethod
-    def _regressor_full(*args, **kwargs):
+    def _regressor_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         regressor(self: dynid._core.Model, q: object, qd: object, qdd: object, rotor: object = False, friction: object = False, columns: object = None, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; with columns (indices into the P columns, e.g. base_parameters(...).independent) only those, (n, len(columns)); out: a preallocated float64 result array of the exact shape.
         """
     @staticmethod
-    def _rnea_full(*args, **kwargs):
+    def _rnea_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         rnea(self: dynid._core.Model, q: object, qd: object, qdd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 

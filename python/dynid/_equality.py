@@ -36,8 +36,11 @@ class ValueEquality:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return all(equal_values(getattr(self, f.name), getattr(other, f.name))
-                   for f in fields(self) if f.compare)
+        return all(
+            equal_values(getattr(self, f.name), getattr(other, f.name))
+            for f in fields(self)
+            if f.compare
+        )
 
     # Unhashable (mutable contents); mypy objects to None in place of the inherited method.
     __hash__ = None  # type: ignore[assignment]

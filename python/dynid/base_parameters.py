@@ -85,8 +85,16 @@ def base_parameters(
     if kind == "inertia" and friction:
         raise ValueError("friction: the inertia regressor has no friction columns")
     # Everything the structure depends on (SPEC 3: not the parameter values, nor the limits).
-    key = (kind, bool(rotor), bool(friction), robot.convention, robot.joint_types,
-           robot.dh.tobytes(), robot.gravity_vector.tobytes(), robot.base.tobytes())
+    key = (
+        kind,
+        bool(rotor),
+        bool(friction),
+        robot.convention,
+        robot.joint_types,
+        robot.dh.tobytes(),
+        robot.gravity_vector.tobytes(),
+        robot.base.tobytes(),
+    )
     cache = robot.__dict__.setdefault("_base_parameter_cache", {})
     if key not in cache:
         cache[key] = _compute(robot, kind, bool(rotor), bool(friction))

@@ -110,8 +110,9 @@ def dynamic_bounds(
     if not isinstance(robot, Robot):
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     per_start = count(samples_per_start, "samples_per_start", 1)
-    samples = count(samples, "samples", per_start,
-                    "at least one block of samples_per_start samples")
+    samples = count(
+        samples, "samples", per_start, "at least one block of samples_per_start samples"
+    )
     optimize = checks.flag(optimize, "optimize")
     seed = count(seed, "seed", 0)
     n = robot.n
@@ -148,8 +149,10 @@ def dynamic_bounds(
 
 def _block_best(values: NDArray[np.float64], per_start: int, starts: int) -> list[int]:
     """Index of the best sample in each of the first ``starts`` full blocks."""
-    return [k * per_start + int(np.argmax(values[k * per_start:(k + 1) * per_start]))
-            for k in range(starts)]
+    return [
+        k * per_start + int(np.argmax(values[k * per_start : (k + 1) * per_start]))
+        for k in range(starts)
+    ]
 
 
 def _refine(
@@ -165,8 +168,13 @@ def _refine(
     value, q = float(values[best]), Q[best].copy()
     sampled = value
     for i in _block_best(values, per_start, starts):
-        res = scipy.optimize.minimize(lambda x: -f(x), Q[i], method="L-BFGS-B",
-                                      bounds=list(map(tuple, qlim)), options=_OPTIONS)
+        res = scipy.optimize.minimize(
+            lambda x: -f(x),
+            Q[i],
+            method="L-BFGS-B",
+            bounds=list(map(tuple, qlim)),
+            options=_OPTIONS,
+        )
         x = np.clip(res.x, qlim[:, 0], qlim[:, 1])
         fx = f(x)
         if fx > value:
@@ -197,8 +205,13 @@ def _coriolis_bound(
     sampled = value
     bounds = list(map(tuple, robot.qlim)) + [(None, None)] * n
     for i in _block_best(values, per_start, starts):
-        res = scipy.optimize.minimize(lambda x: -norm(x), np.concatenate([Q[i], U[i]]),
-                                      method="L-BFGS-B", bounds=bounds, options=_OPTIONS)
+        res = scipy.optimize.minimize(
+            lambda x: -norm(x),
+            np.concatenate([Q[i], U[i]]),
+            method="L-BFGS-B",
+            bounds=bounds,
+            options=_OPTIONS,
+        )
         x = res.x.copy()
         x[:n] = np.clip(x[:n], robot.qlim[:, 0], robot.qlim[:, 1])
         fx = norm(x)

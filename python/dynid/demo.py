@@ -55,12 +55,18 @@ TIP_INERTIA = np.diag([1.5e-4, 1.5e-4, 2.0e-5])  # kg m^2 about its centre: a 9 
 def check_demo_sizes(train: object, validation: object) -> tuple[int, int]:
     """The demo's configuration counts, checked (``ValueError`` naming the argument)."""
     train = count(
-        train, "train", DEMO_MIN_TRAIN,
+        train,
+        "train",
+        DEMO_MIN_TRAIN,
         "the LWR-IV's 12 gravity coefficients get 6 rows per configuration; 3 configurations "
         "leave degrees of freedom for the noise estimate",
     )
-    validation = count(validation, "validation", DEMO_MIN_VALIDATION,
-                       "the validation errors need at least one configuration")
+    validation = count(
+        validation,
+        "validation",
+        DEMO_MIN_VALIDATION,
+        "the validation errors need at least one configuration",
+    )
     return train, validation
 
 
@@ -99,21 +105,32 @@ def run_demo(
 
     # 1. Data from the virtual controller.
     truth = controller_model()
-    noise = {"model_noise": model_noise, "torque_noise": torque_noise, "position_noise": position_noise}
+    noise = {
+        "model_noise": model_noise,
+        "torque_noise": torque_noise,
+        "position_noise": position_noise,
+    }
     controller = VirtualController(truth, seed=seed, link_friction=link_friction, **noise)
     training = controller.read_static(controller.random_configurations(train))
     checking = controller.read_static(controller.random_configurations(validation))
-    step(1, f"virtual LWR-IV controller: {train} training and {validation} validation configurations")
+    step(
+        1, f"virtual LWR-IV controller: {train} training and {validation} validation configurations"
+    )
 
     # 2. Identification from g and M.
     structure = models.kuka_lwr4()
     ident = identify_from_controller(structure, training.q, training.g, training.M)
-    step(2, f"identified {ident.gravity_base.count} gravity and {ident.inertia_base.count} "
-            "inertia coefficients")
+    step(
+        2,
+        f"identified {ident.gravity_base.count} gravity and {ident.inertia_base.count} "
+        "inertia coefficients",
+    )
     progress(_coefficient_table(ident))
     for zero in ident.zero_elements:
-        progress(f"  M[{zero.row + 1},{zero.column + 1}] is zero in all the data; implies: "
-                 + "; ".join(zero.constraints))
+        progress(
+            f"  M[{zero.row + 1},{zero.column + 1}] is zero in all the data; implies: "
+            + "; ".join(zero.constraints)
+        )
 
     # 3. Training / validation errors.
     g_ts = error_metrics(training.g, ident.gravity(training.q))
@@ -140,50 +157,88 @@ def run_demo(
     tve = error_metrics(tau, tau_hat)
     tracking = np.abs(recording.motion.q - recording.q_desired).max(axis=0)
     step(4, "torque validation experiment q_des(t) = pi/2 cos(pi t / 7), T = 14 s")
-    progress("  closed-loop tracking error max [mrad]: "
-             + " ".join(f"{1000 * e:.2f}" for e in tracking))
+    progress(
+        "  closed-loop tracking error max [mrad]: " + " ".join(f"{1000 * e:.2f}" for e in tracking)
+    )
     excluded = (0,)
-    progress(paper_table("Table II  mean square error of the gravity estimate (TVE: of tau_J)",
-                         {"TS": g_ts["mse"], "VS": g_vs["mse"], "TVE": tve["mse"]}, excluded))
-    progress(paper_table("Table III  maximum absolute error (TVE: of tau_J)",
-                         {"TS": g_ts["max_abs"], "VS": g_vs["max_abs"], "TVE": tve["max_abs"]},
-                         excluded, fmt="{:.4g}"))
-    progress(f"  inertia stack: max |error| {m_ts['max_abs']:.3g} (TS), {m_vs['max_abs']:.3g} (VS)"
-             f" over {len(ident.inertia_base.names)} coefficients")
+    progress(
+        paper_table(
+            "Table II  mean square error of the gravity estimate (TVE: of tau_J)",
+            {"TS": g_ts["mse"], "VS": g_vs["mse"], "TVE": tve["mse"]},
+            excluded,
+        )
+    )
+    progress(
+        paper_table(
+            "Table III  maximum absolute error (TVE: of tau_J)",
+            {"TS": g_ts["max_abs"], "VS": g_vs["max_abs"], "TVE": tve["max_abs"]},
+            excluded,
+            fmt="{:.4g}",
+        )
+    )
+    progress(
+        f"  inertia stack: max |error| {m_ts['max_abs']:.3g} (TS), {m_vs['max_abs']:.3g} (VS)"
+        f" over {len(ident.inertia_base.names)} coefficients"
+    )
 
     # 5. A second arm with the 250 g tip.
-    tip_controller = VirtualController(truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA),
-                                       seed=seed + 1, **noise)
+    tip_controller = VirtualController(
+        truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA), seed=seed + 1, **noise
+    )
     tip = tip_controller.read_static(tip_controller.random_configurations(train))
     tip_ident = identify_from_controller(structure, tip.q, tip.g, tip.M)
     estimates = payload_mass_estimates(ident.gravity_base, ident.pi_g, tip_ident.pi_g)
     step(5, f"payload: a {1000 * TIP_MASS:.0f} g tip on the flange, identified again")
     for e in estimates:
-        progress(f"  m_tip = delta({e['coefficient']}) / {e['factor']:g} = {e['mass']:.5f} kg"
-                 f"   [{e['coefficient']} = {e['expression']}]")
+        progress(
+            f"  m_tip = delta({e['coefficient']}) / {e['factor']:g} = {e['mass']:.5f} kg"
+            f"   [{e['coefficient']} = {e['expression']}]"
+        )
 
     # 6. Files.
     files = [
-        plots.plot_joint_signals(recording.t, q, qd, qdd, out / "fig3_joint_motion.png",
-                                 "Filtered joint positions, velocities and accelerations (eq. 33)"),
-        plots.plot_torques(recording.t, tau, tau_hat, out / "fig4_torques.png",
-                           "Sensed joint torques (filtered) and estimated torques, eq. (26)"),
+        plots.plot_joint_signals(
+            recording.t,
+            q,
+            qd,
+            qdd,
+            out / "fig3_joint_motion.png",
+            "Filtered joint positions, velocities and accelerations (eq. 33)",
+        ),
+        plots.plot_torques(
+            recording.t,
+            tau,
+            tau_hat,
+            out / "fig4_torques.png",
+            "Sensed joint torques (filtered) and estimated torques, eq. (26)",
+        ),
         plots.plot_element_comparison(
-            {"g_2(q) [N m]": (checking.g[:, 1], ident.gravity(checking.q)[:, 1]),
-             "M_11(q) [kg m^2]": (checking.M[:, 0, 0], ident.mass_matrix(checking.q)[:, 0, 0])},
-            out / "fig6_g2_M11.png", "Validation set: controller values and identified model"),
+            {
+                "g_2(q) [N m]": (checking.g[:, 1], ident.gravity(checking.q)[:, 1]),
+                "M_11(q) [kg m^2]": (checking.M[:, 0, 0], ident.mass_matrix(checking.q)[:, 0, 0]),
+            },
+            out / "fig6_g2_M11.png",
+            "Validation set: controller values and identified model",
+        ),
     ]
     report = {
         "robot": structure.name,
-        "settings": {"train": train, "validation": validation, "seed": seed,
-                     "link_friction": link_friction, **noise},
+        "settings": {
+            "train": train,
+            "validation": validation,
+            "seed": seed,
+            "link_friction": link_friction,
+            **noise,
+        },
         "tracking_error_max": [float(e) for e in tracking],
         "coefficients": ident.coefficients(),
         "zero_elements": [vars(z) for z in ident.zero_elements],
         "gravity_errors": {"TS": _lists(g_ts), "VS": _lists(g_vs), "TVE": _lists(tve)},
         "inertia_errors": {"TS": m_ts, "VS": m_vs},
-        "condition_numbers": {"gravity": ident.gravity_fit.condition_number,
-                              "inertia": ident.inertia_fit.condition_number},
+        "condition_numbers": {
+            "gravity": ident.gravity_fit.condition_number,
+            "inertia": ident.inertia_fit.condition_number,
+        },
         "payload": {"true_mass": TIP_MASS, "estimates": estimates},
         "plots": [p.name for p in files],
         "seconds": round(time.perf_counter() - start, 2),
@@ -195,8 +250,10 @@ def run_demo(
 
 def _coefficient_table(ident: IdentifiedModel) -> str:
     fit, base = ident.gravity_fit, ident.gravity_base
-    lines = ["  gravity coefficients pi_g [kg m] (paper eq. (28)-(29)):",
-             f"  {'name':<7}{'value':>12}{'std':>11}  expression"]
+    lines = [
+        "  gravity coefficients pi_g [kg m] (paper eq. (28)-(29)):",
+        f"  {'name':<7}{'value':>12}{'std':>11}  expression",
+    ]
     for name, expr, value, std in zip(base.names, base.expressions, fit.theta, fit.std):
         lines.append(f"  {name:<7}{value:>12.5g}{std:>11.2g}  {expr}")
     return "\n".join(lines)

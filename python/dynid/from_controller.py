@@ -147,7 +147,10 @@ def identify_from_controller(
     inertia_base = base_parameters(structure, "inertia")
     Yg = gravity_base.reduce(structure.gravity_regressor(q))  # (N, n, p_g), eq. (21)
     gravity_fit = least_squares(
-        Yg, g, method=method, exclude_joints=exclude_gravity_joints,
+        Yg,
+        g,
+        method=method,
+        exclude_joints=exclude_gravity_joints,
         names=gravity_base.names,
     )
 
@@ -225,7 +228,9 @@ def _samples(value: ArrayLike, name: str, shape: tuple[int, ...]) -> NDArray[np.
     if array.ndim == len(shape):
         array = array[None]
     if array.shape[1:] != shape or array.shape[0] < 1:
-        raise ValueError(f"{name}: expected shape (N, {', '.join(map(str, shape))}), got {array.shape}")
+        raise ValueError(
+            f"{name}: expected shape (N, {', '.join(map(str, shape))}), got {array.shape}"
+        )
     return array
 
 
@@ -244,8 +249,10 @@ def _zero_elements(
             _, s, vt = np.linalg.svd(structural, full_matrices=False)
             space = vt[s > 1e-10 * s[0]]
             constraints.append(space)
-            texts = [linear_expression(row, base.parameter_names) + " = 0"
-                     for row in _echelon(space @ base.beta)]
+            texts = [
+                linear_expression(row, base.parameter_names) + " = 0"
+                for row in _echelon(space @ base.beta)
+            ]
             found.append(ZeroElement(int(i), int(k), texts))
     p = base.count
     if not constraints:
@@ -287,8 +294,12 @@ def _expand(
     covariance = null_space @ reduced.covariance @ null_space.T
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     return replace(
-        reduced, theta=theta, std=std, relative_std=relative_std(theta, std),
-        covariance=covariance, names=names,
+        reduced,
+        theta=theta,
+        std=std,
+        relative_std=relative_std(theta, std),
+        covariance=covariance,
+        names=names,
     )
 
 

@@ -270,8 +270,9 @@ def solve_factors(
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))  # before its square can underflow
     theta = _unscale(theta, b_exp - a_exp, "Y, tau", "the estimate theta ~ tau / Y", sizes)
     std = _unscale(std, b_exp - a_exp, "Y, tau", "the standard deviation of theta", sizes)
-    covariance = _unscale(covariance, 2 * (b_exp - a_exp), "Y, tau", "the covariance of theta",
-                          sizes)
+    covariance = _unscale(
+        covariance, 2 * (b_exp - a_exp), "Y, tau", "the covariance of theta", sizes
+    )
     variance = _unscale(variance, 2 * b_exp, "tau", "the noise variance", sizes)
     residual_rms = _unscale(residual_rms, b_exp, "tau", "the residual RMS", sizes)
     relative = relative_std(theta, std)

@@ -33,8 +33,13 @@ def link_frames(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
     q = np.atleast_2d(q)
     frames = np.empty((q.shape[0], robot.n, 4, 4))
     for i in range(1, robot.n + 1):
-        chain = Robot.from_dh(robot.dh[:i], robot.joint_types[:i], robot.convention,
-                              robot.gravity_vector, base=robot.base)
+        chain = Robot.from_dh(
+            robot.dh[:i],
+            robot.joint_types[:i],
+            robot.convention,
+            robot.gravity_vector,
+            base=robot.base,
+        )
         frames[:, i - 1] = chain.fkine(q[:, :i])
     return frames
 
@@ -45,8 +50,10 @@ def express_in_frames_of(model: Robot, robot: Robot) -> Robot:
     same arm (same joints, same joint variables, link frames on the same bodies, worlds differing
     by a translation, same gravity)."""
     if (model.n, model.joint_types) != (robot.n, robot.joint_types):
-        raise ValueError(f"model: {model.n} joints {model.joint_types!r}, the robot has "
-                         f"{robot.n} joints {robot.joint_types!r}")
+        raise ValueError(
+            f"model: {model.n} joints {model.joint_types!r}, the robot has "
+            f"{robot.n} joints {robot.joint_types!r}"
+        )
     if not np.allclose(model.gravity_vector, robot.gravity_vector, rtol=0, atol=1e-12):
         raise ValueError("model: its gravity differs from the robot's")
     q = robot.random_configurations(SAMPLES, seed=0)
@@ -55,30 +62,35 @@ def express_in_frames_of(model: Robot, robot: Robot) -> Robot:
     # Rotations: R_X,i = R'_i(q)^T R_i(q) constant.
     rotation = np.einsum("tnji,tnjk->tnik", theirs[..., :3, :3], mine[..., :3, :3])
     if np.abs(rotation - rotation[:1]).max() > TOLERANCE:
-        raise ValueError("model: its link frames are not fixed to the robot's links (the "
-                         "rotation between them changes with q): not the same arm or joint "
-                         "convention")
+        raise ValueError(
+            "model: its link frames are not fixed to the robot's links (the "
+            "rotation between them changes with q): not the same arm or joint "
+            "convention"
+        )
     # Translations: p_i - p'_i = t + R'_i x_i, linear least squares in (t, x_1..x_n).
     n, T = robot.n, q.shape[0]
     A: NDArray[np.float64] = np.zeros((T, n, 3, 3 + 3 * n))
     A[..., :3] = np.eye(3)
     for i in range(n):
-        A[:, i, :, 3 + 3 * i:6 + 3 * i] = theirs[:, i, :3, :3]
+        A[:, i, :, 3 + 3 * i : 6 + 3 * i] = theirs[:, i, :3, :3]
     b = (mine[..., :3, 3] - theirs[..., :3, 3]).reshape(-1)
     A = A.reshape(-1, 3 + 3 * n)
     solution = np.linalg.lstsq(A, b, rcond=None)[0]
     if np.abs(A @ solution - b).max() > TOLERANCE * size:
-        raise ValueError("model: its link frames are not fixed to the robot's links, or its "
-                         "world frame is rotated against the robot's: not the same arm")
+        raise ValueError(
+            "model: its link frames are not fixed to the robot's links, or its "
+            "world frame is rotated against the robot's: not the same arm"
+        )
     out = robot.copy()
     params = np.empty((n, 10))
     for i in range(n):
         transform = np.eye(4)
         transform[:3, :3] = rotation[0, i]
-        transform[:3, 3] = solution[3 + 3 * i:6 + 3 * i]
+        transform[:3, 3] = solution[3 + 3 * i : 6 + 3 * i]
         inverse = np.linalg.inv(transform)
         params[i] = standard_from_pseudo_inertia(
-            inverse @ pseudo_inertia(model.params[i]) @ inverse.T)
+            inverse @ pseudo_inertia(model.params[i]) @ inverse.T
+        )
     out.params = params
     out.Ia, out.Fv, out.Fs = model.Ia, model.Fv, model.Fs
     return out

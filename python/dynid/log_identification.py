@@ -64,8 +64,15 @@ DEFAULT_PRIOR_WEIGHT = 1e-5
 STREAM_CHUNK = 8192
 
 #: The options of dynid.io.prepare_log that ``preparation`` may hold.
-PREPARATION = ("cutoff", "order", "differentiate", "decimate", "min_velocity", "outlier_k",
-               "reference_tau")
+PREPARATION = (
+    "cutoff",
+    "order",
+    "differentiate",
+    "decimate",
+    "min_velocity",
+    "outlier_k",
+    "reference_tau",
+)
 
 
 @dataclass(eq=False)
@@ -171,30 +178,47 @@ class LogIdentification(ValueEquality):
     def summary(self) -> str:
         """Coefficients (value, std, relative std, expression), condition number and rank, and
         the per-joint fit on the training log, as text."""
-        options = ", ".join(k.replace("_", " ") for k in ("rotor", "friction", "offset",
-                                                           "position_torque") if getattr(self, k))
+        options = ", ".join(
+            k.replace("_", " ")
+            for k in ("rotor", "friction", "offset", "position_torque")
+            if getattr(self, k)
+        )
         offsets = f" + {self.n} offsets" if self.offset else ""
         if self.position_joints:
-            offsets += (f" + position torque on joint(s) "
-                        f"{', '.join(str(j + 1) for j in self.position_joints)}")
+            offsets += (
+                f" + position torque on joint(s) "
+                f"{', '.join(str(j + 1) for j in self.position_joints)}"
+            )
         columns = "rigid body" + (f", {options}" if options else "")
-        model = (f"model: {self.model.get('name') or '?'} ({self.n} joints, "
-                 f"{self.model['convention']} DH); columns: {columns}")
-        fit = (f"{self.count} base parameters{offsets}, {self.method.upper()}, rank "
-               f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}")
+        model = (
+            f"model: {self.model.get('name') or '?'} ({self.n} joints, "
+            f"{self.model['convention']} DH); columns: {columns}"
+        )
+        fit = (
+            f"{self.count} base parameters{offsets}, {self.method.upper()}, rank "
+            f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}"
+        )
         head = [model, fit]
         if self.physical is not None:
             report = self.physical
-            prior = (f"prior {report.get('prior')} (weight {report.get('prior_weight'):g})"
-                     if report.get("prior") else "no prior")
-            head.append(f"physically consistent fit: SDP, {report.get('solver')} status "
-                        f"{report.get('status')}, {prior}; the values are the base parameters of "
-                        "the identified robot (no standard deviations)")
+            prior = (
+                f"prior {report.get('prior')} (weight {report.get('prior_weight'):g})"
+                if report.get("prior")
+                else "no prior"
+            )
+            head.append(
+                f"physically consistent fit: SDP, {report.get('solver')} status "
+                f"{report.get('status')}, {prior}; the values are the base parameters of "
+                "the identified robot (no standard deviations)"
+            )
         width = max(11, *(len(name) for name in self.names))
-        title = f"  {'coefficient':<{width}}  {'value':>12}  {'std':>10}  {'rel.std':>8}  expression"
+        title = (
+            f"  {'coefficient':<{width}}  {'value':>12}  {'std':>10}  {'rel.std':>8}  expression"
+        )
         lines = [title]
-        for name, value, std, rel, expr in zip(self.names, self.theta, self.std,
-                                               self.relative_std, self.expressions):
+        for name, value, std, rel, expr in zip(
+            self.names, self.theta, self.std, self.relative_std, self.expressions
+        ):
             lines.append(f"  {name:<{width}}  {value:>12.5g}  {std:>10.3g}  {rel:>7.3g}%  {expr}")
         text = "\n".join(head + lines)
         metrics = self.training.get("metrics")
@@ -247,13 +271,9 @@ def identify_log(
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):
-        raise ValueError(
-            f"log: expected a dynid.io.Log, got {type(log).__name__}"
-        )
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
     if not isinstance(robot, Robot):
-        raise ValueError(
-            f"robot: expected a dynid.Robot, got {type(robot).__name__}"
-        )
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
         raise ValueError(f"physical: expected True or False, got {physical!r}")
     if not isinstance(position_torque, (bool, np.bool_)):
@@ -265,38 +285,52 @@ def identify_log(
         prior_weight = DEFAULT_PRIOR_WEIGHT
     options = _options(preparation)
     prepared = _with_derivatives(prepare_log(log, **options), robot.n, robot.name)
+    qd, qdd = prepared.qd, prepared.qdd
+    assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=bool(friction))
     names, expressions = list(base.names), list(base.expressions)
     if offset:
         names += [f"{OFFSET_NAME}{j}" for j in range(1, robot.n + 1)]
         expressions += [f"torque offset of joint {j}" for j in range(1, robot.n + 1)]
-    joints, left_out = ((), ())
+    joints: tuple[int, ...] = ()
+    left_out: tuple[int, ...] = ()
     if position_torque:
-        joints, left_out = position_torque_joints(robot, bool(rotor), bool(friction),
-                                                  bool(offset))
+        joints, left_out = position_torque_joints(robot, bool(rotor), bool(friction), bool(offset))
         more_names, more_expressions = position_names(joints)
         names += more_names
         expressions += more_expressions
     result = LogIdentification(
-        model=model_to_dict(robot), rotor=bool(rotor), friction=bool(friction),
-        offset=bool(offset), method=method, parameter_names=list(base.parameter_names),
-        independent=base.independent.copy(), beta=base.beta.copy(), names=names,
-        expressions=expressions, theta=np.zeros(len(names)), std=np.zeros(len(names)),
-        relative_std=np.zeros(len(names)), condition_number=np.nan, rank=0, log=prepared,
-        position_joints=joints, _robot=robot,
+        model=model_to_dict(robot),
+        rotor=bool(rotor),
+        friction=bool(friction),
+        offset=bool(offset),
+        method=method,
+        parameter_names=list(base.parameter_names),
+        independent=base.independent.copy(),
+        beta=base.beta.copy(),
+        names=names,
+        expressions=expressions,
+        theta=np.zeros(len(names)),
+        std=np.zeros(len(names)),
+        relative_std=np.zeros(len(names)),
+        condition_number=np.nan,
+        rank=0,
+        log=prepared,
+        position_joints=joints,
+        _robot=robot,
     )
     # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
     # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
     chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
     accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
     for c in chunks:
-        accumulator.add(result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]),
-                        prepared.tau[c])
+        accumulator.add(result.regressor(prepared.q[c], qd[c], qdd[c]), prepared.tau[c])
     # The physical fit needs the least squares only for the rank, the condition number and the
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
-    fit = accumulator.solve(method=method, names=names,
-                            on_rank_deficient="warn" if physical else "raise")
+    fit = accumulator.solve(
+        method=method, names=names, on_rank_deficient="warn" if physical else "raise"
+    )
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.covariance = fit.covariance
@@ -312,15 +346,24 @@ def identify_log(
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
         "notes": list(prepared.notes) + _position_notes(left_out),
-        "metrics": error_metrics(prepared.tau, np.concatenate(
-            [result.regressor(prepared.q[c], prepared.qd[c], prepared.qdd[c]) @ result.theta
-             for c in chunks])),
+        "metrics": error_metrics(
+            prepared.tau,
+            np.concatenate(
+                [result.regressor(prepared.q[c], qd[c], qdd[c]) @ result.theta for c in chunks]
+            ),
+        ),
     }
     return result
 
 
-def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.float64],
-              prior: Robot | None, prior_weight: float, source: Any) -> None:
+def _physical(
+    result: LogIdentification,
+    log: Log,
+    noise_variance: NDArray[np.float64],
+    prior: Robot | None,
+    prior_weight: float,
+    source: Any,
+) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one."""
     robot, n = result.robot, result.n
     assert log.qd is not None and log.qdd is not None  # the prepared log (_with_derivatives)
@@ -339,9 +382,17 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
         floored = np.maximum(noise_variance, VARIANCE_FLOOR * noise_variance.max())
         weights[kept] = 1.0 / np.sqrt(floored)
     weights[list(result.excluded)] = 0.0
-    fit = physical_least_squares(robot, Y, log.tau, rotor=result.rotor, friction=result.friction,
-                                 weights=weights, prior=prior, prior_weight=prior_weight,
-                                 extra_columns=extra)
+    fit = physical_least_squares(
+        robot,
+        Y,
+        log.tau,
+        rotor=result.rotor,
+        friction=result.friction,
+        weights=weights,
+        prior=prior,
+        prior_weight=prior_weight,
+        extra_columns=extra,
+    )
     result.theta = np.concatenate([fit.base_values, fit.extra])
     result.std = np.full(result.theta.size, np.inf)
     result.relative_std = np.full(result.theta.size, np.inf)
@@ -349,12 +400,16 @@ def _physical(result: LogIdentification, log: Log, noise_variance: NDArray[np.fl
     result.model = model_to_dict(fit.robot)
     result._robot = fit.robot
     result.physical = {
-        "status": fit.status, "solver": fit.solver,
+        "status": fit.status,
+        "solver": fit.solver,
         "solve_time_s": fit.solve_time if np.isfinite(fit.solve_time) else None,
-        "setup_time_s": fit.setup_time, "objective": fit.objective,
-        "prior": None if source is None else (str(source) if not isinstance(source, Robot)
-                                              else f"<Robot {source.name}>"),
-        "prior_weight": prior_weight, "margin": fit.options["margin"],
+        "setup_time_s": fit.setup_time,
+        "objective": fit.objective,
+        "prior": None
+        if source is None
+        else (str(source) if not isinstance(source, Robot) else f"<Robot {source.name}>"),
+        "prior_weight": prior_weight,
+        "margin": fit.options["margin"],
         "projected_links": [i + 1 for i in fit.projected],
         "min_pseudo_inertia_eigenvalues": fit.min_eigenvalues.tolist(),
     }
@@ -364,8 +419,10 @@ def _position_notes(left_out: tuple[int, ...]) -> list[str]:
     if not left_out:
         return []
     joints = ", ".join(str(j + 1) for j in left_out)
-    return [f"position torque: not on joint(s) {joints}, where sin q, cos q are combinations of "
-            "the rigid-body columns (gravity) and cannot be told apart from them"]
+    return [
+        f"position torque: not on joint(s) {joints}, where sin q, cos q are combinations of "
+        "the rigid-body columns (gravity) and cannot be told apart from them"
+    ]
 
 
 def _prior_model(prior: Any) -> Robot:
@@ -374,8 +431,10 @@ def _prior_model(prior: Any) -> Robot:
     if isinstance(prior, Robot):
         return prior
     if not isinstance(prior, (str, Path)):
-        raise ValueError(f"prior: expected a dynid.Robot or the path of a model file or URDF, "
-                         f"got {type(prior).__name__}")
+        raise ValueError(
+            f"prior: expected a dynid.Robot or the path of a model file or URDF, "
+            f"got {type(prior).__name__}"
+        )
     return load_model(prior)
 
 
@@ -403,10 +462,13 @@ def run_validation(
     notes = []
     trained = result.training.get("preparation", {}).get("cutoff")
     if trained != options.get("cutoff"):
-        notes.append(f"the training log was {_filtered(trained)}, this one is "
-                     f"{_filtered(options.get('cutoff'))}")
-    return LogValidation(prepared, predicted, error_metrics(prepared.tau, predicted), options,
-                         notes)
+        notes.append(
+            f"the training log was {_filtered(trained)}, this one is "
+            f"{_filtered(options.get('cutoff'))}"
+        )
+    return LogValidation(
+        prepared, predicted, error_metrics(prepared.tau, predicted), options, notes
+    )
 
 
 def validate_log(
@@ -427,8 +489,10 @@ def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:
     options = {k: v for k, v in dict(preparation or {}).items() if v is not None}
     unknown = sorted(set(options) - set(PREPARATION))
     if unknown:
-        raise ValueError(f"preparation: unknown option(s) {unknown}; expected some of "
-                         f"{', '.join(PREPARATION)} (dynid.io.prepare_log)")
+        raise ValueError(
+            f"preparation: unknown option(s) {unknown}; expected some of "
+            f"{', '.join(PREPARATION)} (dynid.io.prepare_log)"
+        )
     return options
 
 
@@ -444,9 +508,7 @@ def _plain(value: Any) -> Any:
 
 def _with_derivatives(log: Log, n: int, name: str) -> Log:
     if not isinstance(log, Log):
-        raise ValueError(
-            f"log: expected a dynid.io.Log, got {type(log).__name__}"
-        )
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
     if log.n != n:
         raise ValueError(f"log: has {log.n} joints, but the model {name!r} has {n}")
     if log.qd is None or log.qdd is None:

@@ -184,7 +184,11 @@ def planar_2r(
     else:
         raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
     robot = Robot.from_dh(
-        dh, joint_types="RR", convention=convention, gravity=tuple(gravity), tool=tool,
+        dh,
+        joint_types="RR",
+        convention=convention,
+        gravity=tuple(gravity),
+        tool=tool,
         name="planar 2R",
     )
     for i, (length, lc, m, izz) in enumerate(((l1, lc1, m1, I1), (l2, lc2, m2, I2))):
@@ -289,13 +293,20 @@ def panda() -> Robot:
     Robot
         A 7-DOF robot named ``"Franka Emika Panda"`` (modified DH).
     """
-    table = np.loadtxt(_data_file("franka_panda_gaz2019.csv"), delimiter=",", comments="#",
-                       skiprows=7)
+    table = np.loadtxt(
+        _data_file("franka_panda_gaz2019.csv"), delimiter=",", comments="#", skiprows=7
+    )
     tool = np.eye(4)
     tool[2, 3] = _PANDA_FLANGE
-    robot = Robot.from_dh(_PANDA_DH, joint_types="R" * 7, convention="modified",
-                          gravity=(0.0, 0.0, -9.81), tool=tool, qlim=_PANDA_QLIM,
-                          name="Franka Emika Panda")
+    robot = Robot.from_dh(
+        _PANDA_DH,
+        joint_types="R" * 7,
+        convention="modified",
+        gravity=(0.0, 0.0, -9.81),
+        tool=tool,
+        qlim=_PANDA_QLIM,
+        name="Franka Emika Panda",
+    )
     for i, (_, m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz) in enumerate(table):
         inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
         robot.set_link(i, m, (cx, cy, cz), inertia)
@@ -333,8 +344,9 @@ def ur10(convention: str = "standard") -> Robot:
 
 
 def _ur(file: str, name: str, convention: str) -> Robot:
-    robot = Robot.from_urdf(_data_file(file).read_text(encoding="utf-8"), tip_link="tool0",
-                            convention=convention)
+    robot = Robot.from_urdf(
+        _data_file(file).read_text(encoding="utf-8"), tip_link="tool0", convention=convention
+    )
     robot.name = name
     return robot
 

@@ -103,7 +103,9 @@ def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | 
     )
 
 
-def plot_residual(residual: Residual, path: str | Path, threshold: float | Array | None = None) -> Path:
+def plot_residual(
+    residual: Residual, path: str | Path, threshold: float | Array | None = None
+) -> Path:
     """One panel per joint of r(t) (N m or N), with +-``threshold`` lines when given; saved as
     an image at ``path`` (the format from its suffix, e.g. .png)."""
     import matplotlib
@@ -113,15 +115,24 @@ def plot_residual(residual: Residual, path: str | Path, threshold: float | Array
 
     n = residual.r.shape[1]
     fig, axes = plt.subplots(n, 1, sharex=True, figsize=(8, 1.6 * n + 1), squeeze=False)
-    limits = None if threshold is None else np.broadcast_to(real_array(threshold, "threshold"), (n,))
+    limits = (
+        None if threshold is None else np.broadcast_to(real_array(threshold, "threshold"), (n,))
+    )
     for j, ax in enumerate(axes[:, 0]):
         ax.plot(residual.t - residual.t[0], residual.r[:, j], lw=0.8)
         if limits is not None:
             for sign in (-1, 1):
                 ax.axhline(sign * limits[j], color="tab:red", lw=0.6, ls="--")
         ax.set_ylabel(f"r{j + 1}")
-        ax.text(0.99, 0.9, f"RMS {residual.rms[j]:.3g}", transform=ax.transAxes, ha="right",
-                va="top", fontsize=8)
+        ax.text(
+            0.99,
+            0.9,
+            f"RMS {residual.rms[j]:.3g}",
+            transform=ax.transAxes,
+            ha="right",
+            va="top",
+            fontsize=8,
+        )
     fig.axes[-1].set_xlabel("t - t0 [s]")  # the bottom panel, axes[-1, 0] (typed as an Axes)
     gains = ", ".join(f"{g:g}" for g in np.unique(residual.gain))
     fig.suptitle(f"momentum-observer residual [N m] (gain {gains} 1/s, dt {residual.dt:.4g} s)")
@@ -135,6 +146,13 @@ def plot_residual(residual: Residual, path: str | Path, threshold: float | Array
 def save_residual(residual: Residual, path: str | Path) -> Path:
     """The residual as an .npz file: t, r, gain, dt, rms, max_abs."""
     out = Path(path)
-    np.savez(out, t=residual.t, r=residual.r, gain=residual.gain, dt=residual.dt,
-             rms=residual.rms, max_abs=residual.max_abs)
+    np.savez(
+        out,
+        t=residual.t,
+        r=residual.r,
+        gain=residual.gain,
+        dt=residual.dt,
+        rms=residual.rms,
+        max_abs=residual.max_abs,
+    )
     return out

@@ -117,7 +117,9 @@ def cartesian_dynamics(
     g = robot.gravity(q_array)
     J, _, Y = _task_mobility(robot, q_array, selected)
     Lam = _inverse_checked(J @ Y, selected)
-    Jdot_qd = (robot.jacobian_dot(q_array, qd)[..., selected, :] @ np.asarray(qd, dtype=float)[..., None])[..., 0]
+    Jdot_qd = (
+        robot.jacobian_dot(q_array, qd)[..., selected, :] @ np.asarray(qd, dtype=float)[..., None]
+    )[..., 0]
     Yt = np.swapaxes(Y, -1, -2)  # J M^-1 (M symmetric)
     mu = (Lam @ ((Yt @ c[..., None])[..., 0] - Jdot_qd)[..., None])[..., 0]
     p = (Lam @ (Yt @ g[..., None]))[..., 0]

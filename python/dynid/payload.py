@@ -92,13 +92,17 @@ class PayloadEstimate(ValueEquality):
     def as_dict(self) -> dict[str, object]:
         """JSON-ready values (floats, nested lists, None): mass, com, inertia with their std,
         the standard parameters and the frame."""
+
         def plain(value: NDArray[np.float64] | None) -> list | None:
             return None if value is None else np.asarray(value).tolist()
 
         return {
-            "mass": self.mass, "mass_std": self.mass_std,
-            "com": plain(self.com), "com_std": plain(self.com_std),
-            "inertia": plain(self.inertia), "inertia_std": plain(self.inertia_std),
+            "mass": self.mass,
+            "mass_std": self.mass_std,
+            "com": plain(self.com),
+            "com_std": plain(self.com_std),
+            "inertia": plain(self.inertia),
+            "inertia_std": plain(self.inertia_std),
             "parameters": dict(zip(PAYLOAD_NAMES, self.parameters.tolist())),
             "parameters_std": dict(zip(PAYLOAD_NAMES, self.parameters_std.tolist())),
             "frame": self.frame,
@@ -156,8 +160,10 @@ def estimate_payload(
     exclude_joints = checks.indices(exclude_joints, "exclude_joints", robot.n)
     if not isinstance(frame, str) or frame not in FRAMES:
         raise ValueError(f"frame: expected one of {FRAMES}, got {frame!r}")
-    q, qd, qdd, tau = (_samples(value, name, robot.n) for value, name in
-                       ((q, "q"), (qd, "qd"), (qdd, "qdd"), (tau, "tau")))
+    q, qd, qdd, tau = (
+        _samples(value, name, robot.n)
+        for value, name in ((q, "q"), (qd, "qd"), (qdd, "qdd"), (tau, "tau"))
+    )
     shape = q.shape
     for value, name in ((qd, "qd"), (qdd, "qdd"), (tau, "tau")):
         if value.shape != shape:
@@ -167,8 +173,9 @@ def estimate_payload(
     else:
         tau_unloaded = _samples(tau_unloaded, "tau_unloaded", robot.n)
         if tau_unloaded.shape != shape:
-            raise ValueError(f"tau_unloaded: expected the shape of q {shape}, got "
-                             f"{tau_unloaded.shape}")
+            raise ValueError(
+                f"tau_unloaded: expected the shape of q {shape}, got {tau_unloaded.shape}"
+            )
     static = not (np.any(qd) or np.any(qdd))
     if not inertia and not static:
         raise ValueError(
@@ -177,7 +184,7 @@ def estimate_payload(
             "inertia=True"
         )
     columns = 10 if inertia else 4
-    Y = robot.regressor(q, qd, qdd)[..., 10 * (robot.n - 1):10 * (robot.n - 1) + columns]
+    Y = robot.regressor(q, qd, qdd)[..., 10 * (robot.n - 1) : 10 * (robot.n - 1) + columns]
     names = list(PAYLOAD_NAMES[:columns])
     rows = shape[0] * (robot.n - len(exclude_joints))
     if rows < columns:
@@ -186,11 +193,15 @@ def estimate_payload(
             "parameters; use many more samples (a well-excited trajectory)"
         )
     try:
-        fit = least_squares(Y, tau - tau_unloaded, method=method, exclude_joints=exclude_joints,
-                            names=names)
+        fit = least_squares(
+            Y, tau - tau_unloaded, method=method, exclude_joints=exclude_joints, names=names
+        )
     except RankDeficientError as exc:
-        hint = (" Static data (qd = qdd = 0) do not excite the inertia: pass inertia=False."
-                if static and inertia else "")
+        hint = (
+            " Static data (qd = qdd = 0) do not excite the inertia: pass inertia=False."
+            if static and inertia
+            else ""
+        )
         raise RankDeficientError(f"the data do not determine the payload: {exc}{hint}") from None
     return _physical(fit.theta, fit.covariance, robot, frame, fit)
 
@@ -224,13 +235,19 @@ def payload_from_identified(
     if not isinstance(frame, str) or frame not in FRAMES:
         raise ValueError(f"frame: expected one of {FRAMES}, got {frame!r}")
     robot = unloaded.structure
-    same = all(np.array_equal(getattr(a, field), getattr(b, field))
-               for a, b in ((unloaded.gravity_base, loaded.gravity_base),
-                            (unloaded.inertia_base, loaded.inertia_base))
-               for field in ("independent", "beta"))
+    same = all(
+        np.array_equal(getattr(a, field), getattr(b, field))
+        for a, b in (
+            (unloaded.gravity_base, loaded.gravity_base),
+            (unloaded.inertia_base, loaded.inertia_base),
+        )
+        for field in ("independent", "beta")
+    )
     if not same or not np.array_equal(robot.dh, loaded.structure.dh):
-        raise ValueError("loaded: identified on another structure than unloaded (different DH "
-                         "table or base coefficients): the coefficients cannot be compared")
+        raise ValueError(
+            "loaded: identified on another structure than unloaded (different DH "
+            "table or base coefficients): the coefficients cannot be compared"
+        )
     last = slice(10 * (robot.n - 1), 10 * robot.n)
     B = np.vstack([unloaded.gravity_base.beta[:, last], unloaded.inertia_base.beta[:, last]])
     change = np.concatenate([loaded.pi_g - unloaded.pi_g, loaded.pi_m - unloaded.pi_m])
@@ -263,9 +280,9 @@ def payload_from_identified(
     return _physical(theta, propagated, robot, frame, None)
 
 
-def physical_from_parameters(theta: NDArray[np.float64]) -> tuple[
-    NDArray[np.float64], NDArray[np.float64]
-]:
+def physical_from_parameters(
+    theta: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(m, c (3), I_C (6, upper triangle xx xy xz yy yz zz)) from pi = (m, h, I_O (6)) and the
     Jacobian of that map (delta method): c = h / m, I_C = I_O - S(h) / m, S(h) = |h|^2 E - h h^T.
     With 4 entries (no inertia), (m, c) and its 4x4 Jacobian."""
@@ -279,14 +296,16 @@ def physical_from_parameters(theta: NDArray[np.float64]) -> tuple[
         return phi, G
     S6 = (h @ h * np.eye(3) - np.outer(h, h))[_ROWS, _COLS]
     # d S6 / d h, rows xx xy xz yy yz zz
-    dS = np.array([
-        [0, 2 * h[1], 2 * h[2]],
-        [-h[1], -h[0], 0],
-        [-h[2], 0, -h[0]],
-        [2 * h[0], 0, 2 * h[2]],
-        [0, -h[2], -h[1]],
-        [2 * h[0], 2 * h[1], 0],
-    ])
+    dS = np.array(
+        [
+            [0, 2 * h[1], 2 * h[2]],
+            [-h[1], -h[0], 0],
+            [-h[2], 0, -h[0]],
+            [2 * h[0], 0, 2 * h[2]],
+            [0, -h[2], -h[1]],
+            [2 * h[0], 2 * h[1], 0],
+        ]
+    )
     G[4:, 0] = S6 / m**2
     G[4:, 1:4] = -dS / m
     G[4:, 4:] = np.eye(6)
@@ -303,8 +322,14 @@ def _physical(
     parameters_std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     mass, mass_std = float(theta[0]), float(parameters_std[0])
     total = float(np.abs(robot.params[:, 0]).sum()) or 1.0
-    common: dict[str, Any] = {"mass": mass, "mass_std": mass_std, "parameters": theta.copy(),
-              "parameters_std": parameters_std, "frame": frame, "fit": fit}
+    common: dict[str, Any] = {
+        "mass": mass,
+        "mass_std": mass_std,
+        "parameters": theta.copy(),
+        "parameters_std": parameters_std,
+        "frame": frame,
+        "fit": fit,
+    }
     if not mass > max(SIGNIFICANCE * mass_std, MASS_FLOOR * total):
         return PayloadEstimate(com=None, com_std=None, inertia=None, inertia_std=None, **common)
     phi, G = physical_from_parameters(theta)
@@ -319,8 +344,9 @@ def _physical(
     inertia = inertia_std = None
     if theta.size == 10:
         inertia, inertia_std = _symmetric(phi[4:]), _symmetric(std[4:])
-    return PayloadEstimate(com=com, com_std=com_std, inertia=inertia, inertia_std=inertia_std,
-                           **common)
+    return PayloadEstimate(
+        com=com, com_std=com_std, inertia=inertia, inertia_std=inertia_std, **common
+    )
 
 
 def _frame_map(robot: Robot, frame: str, size: int) -> NDArray[np.float64]:

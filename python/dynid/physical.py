@@ -182,8 +182,7 @@ def physical_least_squares(
 
     started = time.perf_counter()
     if not isinstance(robot, Robot):
-        raise ValueError(
-            f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     rotor, friction = check_flag(rotor, "rotor"), check_flag(friction, "friction")
     n = robot.n
     P = robot.parameter_vector(rotor, friction).size
@@ -230,18 +229,24 @@ def physical_least_squares(
     except cp.error.SolverError as exc:
         raise PhysicalIdentificationError(
             f"the physically consistent fit failed: the solver {SOLVER} stopped with an error "
-            f"({exc}); no model is returned", "solver_error") from None
+            f"({exc}); no model is returned",
+            "solver_error",
+        ) from None
     solve_time = problem.solver_stats.solve_time
     solve_time = float(solve_time) if solve_time is not None else float("nan")
     setup = time.perf_counter() - started - (solve_time if np.isfinite(solve_time) else 0.0)
     status = str(problem.status)
     if status != cp.OPTIMAL:
-        why = {cp.INFEASIBLE: " (the constraints cannot all hold: check mass_bounds, total_mass "
-                              "and margin against each other)",
-               cp.OPTIMAL_INACCURATE: " (the solver did not reach its tolerances)"}
+        why = {
+            cp.INFEASIBLE: " (the constraints cannot all hold: check mass_bounds, total_mass "
+            "and margin against each other)",
+            cp.OPTIMAL_INACCURATE: " (the solver did not reach its tolerances)",
+        }
         raise PhysicalIdentificationError(
             f"the physically consistent fit failed: solver {SOLVER} status {status!r}"
-            f"{why.get(status, '')}; no model is returned", status)
+            f"{why.get(status, '')}; no model is returned",
+            status,
+        )
 
     # Remove the solver's tiny constraint violations (documented above), then check.
     params = np.empty((n, 10))
@@ -259,7 +264,8 @@ def physical_least_squares(
         raise PhysicalIdentificationError(
             f"the physically consistent fit failed: solver {SOLVER} reported {status!r} but its "
             f"solution violates the margin by {worst:.3g} (relative); no model is returned",
-            "inaccurate")
+            "inaccurate",
+        )
     extra = np.asarray(free.value, dtype=float) if free is not None else np.zeros(0)
     theta = np.concatenate([params.reshape(-1), drive_values, extra])
     identified = _identified_robot(robot, params, drive_values, rotor, friction)
@@ -268,18 +274,33 @@ def physical_least_squares(
     base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
     residual = tau2 - Y3 @ theta
     return PhysicalResult(
-        robot=identified, params=params,
+        robot=identified,
+        params=params,
         Ia=drive_values[:n].copy() if rotor else None,
-        Fv=drive_values[n * rotor:n * rotor + n].copy() if friction else None,
-        Fs=drive_values[n * rotor + n:].copy() if friction else None,
-        extra=extra, theta=theta, base_values=base.beta @ theta[:P], base_names=list(base.names),
-        residual_rms=np.sqrt(np.mean(residual**2, axis=0)), status=status,
-        objective=float(problem.value) ** 2, solver=SOLVER,
+        Fv=drive_values[n * rotor : n * rotor + n].copy() if friction else None,
+        Fs=drive_values[n * rotor + n :].copy() if friction else None,
+        extra=extra,
+        theta=theta,
+        base_values=base.beta @ theta[:P],
+        base_names=list(base.names),
+        residual_rms=np.sqrt(np.mean(residual**2, axis=0)),
+        status=status,
+        objective=float(problem.value) ** 2,
+        solver=SOLVER,
         solve_time=solve_time,
-        setup_time=setup, min_eigenvalues=min_eig, min_mass_matrix_eigenvalue=mass_eig,
-        projected=tuple(projected), projection=worst,
-        options={"rotor": rotor, "friction": friction, "prior_weight": prior_weight,
-                 "margin": margin, "extra_columns": k, "prior": prior is not None},
+        setup_time=setup,
+        min_eigenvalues=min_eig,
+        min_mass_matrix_eigenvalue=mass_eig,
+        projected=tuple(projected),
+        projection=worst,
+        options={
+            "rotor": rotor,
+            "friction": friction,
+            "prior_weight": prior_weight,
+            "margin": margin,
+            "extra_columns": k,
+            "prior": prior is not None,
+        },
     )
 
 
@@ -290,23 +311,32 @@ def _standard_from_vec_j() -> NDArray[np.float64]:
     """G (10, 16) with pi_i = G vec(J_i) (column-major vec) for a symmetric J_i: the linear map
     of :func:`dynid.pseudo_inertia.standard_from_pseudo_inertia`, which reads each
     off-diagonal pair as the mean of its two entries."""
-    return np.column_stack([standard_from_pseudo_inertia(unit.reshape(4, 4, order="F"))
-                            for unit in np.eye(16)])
+    return np.column_stack(
+        [standard_from_pseudo_inertia(unit.reshape(4, 4, order="F")) for unit in np.eye(16)]
+    )
 
 
 _STANDARD_FROM_J = _standard_from_vec_j()
 
 
-def _prior_terms(J: list, drive: Any, prior_x: NDArray[np.float64], weight: float,
-                 Y3: NDArray[np.float64], tau2: NDArray[np.float64], n: int, rotor: bool,
-                 friction: bool) -> list:
+def _prior_terms(
+    J: list,
+    drive: Any,
+    prior_x: NDArray[np.float64],
+    weight: float,
+    Y3: NDArray[np.float64],
+    tau2: NDArray[np.float64],
+    n: int,
+    rotor: bool,
+    friction: bool,
+) -> list:
     """sqrt(weight) times the scaled deviations from the prior (module docstring)."""
     import cvxpy as cp
 
     root = np.sqrt(weight)
     terms = []
     for i, Ji in enumerate(J):
-        Jp = pseudo_inertia(prior_x[10 * i:10 * i + 10])
+        Jp = pseudo_inertia(prior_x[10 * i : 10 * i + 10])
         mass = Jp[3, 3]
         length = np.sqrt(np.trace(Jp[:3, :3]) / mass)
         s = np.array([1 / length, 1 / length, 1 / length, 1.0])
@@ -320,20 +350,25 @@ def _prior_terms(J: list, drive: Any, prior_x: NDArray[np.float64], weight: floa
         scale = np.ones(joints.size)
         usable = (rms_tau > 0) & (rms_col > 0)
         scale[usable] = rms_tau[usable] / rms_col[usable]
-        terms.append(root * (drive - prior_x[10 * n:]) / scale)
+        terms.append(root * (drive - prior_x[10 * n :]) / scale)
     return terms
 
 
-def _identified_robot(robot: Robot, params: NDArray[np.float64], drive: NDArray[np.float64],
-                      rotor: bool, friction: bool) -> Robot:
+def _identified_robot(
+    robot: Robot,
+    params: NDArray[np.float64],
+    drive: NDArray[np.float64],
+    rotor: bool,
+    friction: bool,
+) -> Robot:
     identified = robot.copy()
     identified.params = params
     n = robot.n
     zeros = np.zeros(n)
     identified.Ia = drive[:n] if rotor else zeros
     offset = n if rotor else 0
-    identified.Fv = drive[offset:offset + n] if friction else zeros
-    identified.Fs = drive[offset + n:offset + 2 * n] if friction else zeros
+    identified.Fv = drive[offset : offset + n] if friction else zeros
+    identified.Fs = drive[offset + n : offset + 2 * n] if friction else zeros
     return identified
 
 
@@ -344,19 +379,22 @@ def _check(robot: Robot, min_eig: NDArray[np.float64]) -> float:
         raise PhysicalIdentificationError(
             f"the physically consistent fit failed its check: link(s) {bad} not physically "
             f"consistent after the solve (smallest pseudo-inertia eigenvalues {min_eig})",
-            "inconsistent")
+            "inconsistent",
+        )
     q = robot.random_configurations(CHECK_CONFIGURATIONS, seed=0)
     smallest = float(np.linalg.eigvalsh(robot.mass_matrix(q)).min())
     if not smallest > 0:
         raise PhysicalIdentificationError(
             f"the physically consistent fit failed its check: M(q) is not positive definite "
             f"(smallest eigenvalue {smallest:.3g} over {CHECK_CONFIGURATIONS} configurations)",
-            "not_positive_definite")
+            "not_positive_definite",
+        )
     return smallest
 
 
-def _compressed(A: NDArray[np.float64], b: NDArray[np.float64]
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+def _compressed(
+    A: NDArray[np.float64], b: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
     """R, c = Q^T b and r0 with ||A z - b||^2 = ||R z - c||^2 + r0^2 for every z, from one
     Householder QR of [A | b] without forming Q: its triangle is [[R, c], [0, r0]]."""
     rows, columns = A.shape

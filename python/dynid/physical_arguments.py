@@ -13,22 +13,26 @@ from .link_frames import express_in_frames_of
 from .robot import Robot
 
 
-def check_data(Y: ArrayLike, tau: ArrayLike, n: int, columns: int
-          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def check_data(
+    Y: ArrayLike, tau: ArrayLike, n: int, columns: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     Y = real_array(Y, "Y")
     tau = real_array(tau, "tau")
     if Y.ndim in (2, 3) and Y.shape[-1] != columns:
-        raise ValueError(f"Y: expected {columns} columns (the regressor of the model with the "
-                         "rotor/friction options given, plus extra_columns), got "
-                         f"{Y.shape[-1]}")
+        raise ValueError(
+            f"Y: expected {columns} columns (the regressor of the model with the "
+            "rotor/friction options given, plus extra_columns), got "
+            f"{Y.shape[-1]}"
+        )
     if Y.ndim == 2:
         if Y.shape[0] == 0 or Y.shape[0] % n:
-            raise ValueError(f"Y: expected (N, {columns}) with N a positive multiple of n = {n} "
-                             f"(rows sample after sample), got shape {Y.shape}")
+            raise ValueError(
+                f"Y: expected (N, {columns}) with N a positive multiple of n = {n} "
+                f"(rows sample after sample), got shape {Y.shape}"
+            )
         Y = Y.reshape(-1, n, Y.shape[1])
         if tau.shape != (Y.shape[0] * n,):
-            raise ValueError(f"tau: expected shape ({Y.shape[0] * n},) to match Y, got "
-                             f"{tau.shape}")
+            raise ValueError(f"tau: expected shape ({Y.shape[0] * n},) to match Y, got {tau.shape}")
         tau = tau.reshape(-1, n)
     elif Y.ndim == 3:
         if Y.shape[0] == 0 or Y.shape[1] != n:
@@ -49,8 +53,10 @@ def check_weights(weights: ArrayLike | None, T: int, n: int) -> NDArray[np.float
     elif w.shape == (T * n,):
         w = w.reshape(T, n)
     elif w.shape != (T, n):
-        raise ValueError(f"weights: expected one per joint ({n},) or one per row ({T}, {n}) / "
-                         f"({T * n},), got shape {w.shape}")
+        raise ValueError(
+            f"weights: expected one per joint ({n},) or one per row ({T}, {n}) / "
+            f"({T * n},), got shape {w.shape}"
+        )
     if np.any(w < 0) or not np.any(w > 0):
         raise ValueError("weights: expected non-negative values, at least one positive")
     return np.array(w, dtype=float)
@@ -62,12 +68,12 @@ def check_prior(prior: Any, robot: Robot, rotor: bool, friction: bool) -> NDArra
     keeps every link frame), else re-expressed by :func:`dynid.link_frames.express_in_frames_of`
     (e.g. a URDF's or the other convention's table of the same arm)."""
     if not isinstance(prior, Robot):
-        raise ValueError(
-            f"prior: expected a dynid.Robot, got {type(prior).__name__}")
+        raise ValueError(f"prior: expected a dynid.Robot, got {type(prior).__name__}")
     if (prior.n, prior.joint_types) != (robot.n, robot.joint_types):
         raise ValueError(
             f"prior: expected a model of the robot's joints ({robot.n} joints "
-            f"{robot.joint_types!r}), got {prior.n} joints {prior.joint_types!r}")
+            f"{robot.joint_types!r}), got {prior.n} joints {prior.joint_types!r}"
+        )
     bad = [f"link {i + 1}: {why}" for i in range(prior.n) if (why := prior._link_inconsistency(i))]
     if bad:
         raise ValueError("prior: expected a physically consistent model, " + "; ".join(bad))
@@ -81,9 +87,10 @@ def check_prior(prior: Any, robot: Robot, rotor: bool, friction: bool) -> NDArra
         except ValueError as exc:
             raise ValueError(
                 "prior: its standard parameters are not in the robot's DH frames (the two "
-                f"regressors differ) and cannot be mapped to them: {exc}") from None
+                f"regressors differ) and cannot be mapped to them: {exc}"
+            ) from None
     values = prior.parameter_vector(rotor, friction)
-    if np.any(values[10 * prior.n:] < 0):
+    if np.any(values[10 * prior.n :] < 0):
         raise ValueError("prior: its Ia, Fv, Fs must be >= 0 (the estimate's are)")
     return values
 
@@ -100,26 +107,33 @@ def check_prior_weight(value: Any, prior: Any) -> float:
     if weight > 0 and prior is None:
         raise ValueError(f"prior_weight: {weight} > 0 needs a prior model (prior is None)")
     if weight == 0 and prior is not None:
-        raise ValueError("prior_weight: a prior is given but prior_weight is 0, so it would be "
-                         "ignored; give prior_weight > 0")
+        raise ValueError(
+            "prior_weight: a prior is given but prior_weight is 0, so it would be "
+            "ignored; give prior_weight > 0"
+        )
     return weight
 
 
-def check_mass_bounds(value: ArrayLike | None, n: int
-                 ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+def check_mass_bounds(
+    value: ArrayLike | None, n: int
+) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
     if value is None:
         return None, None
     bounds = real_array(value, "mass_bounds", finite=False)
     if bounds.shape != (n, 2):
-        raise ValueError(f"mass_bounds: expected shape ({n}, 2) [lower, upper] per link, got "
-                         f"{bounds.shape}")
+        raise ValueError(
+            f"mass_bounds: expected shape ({n}, 2) [lower, upper] per link, got {bounds.shape}"
+        )
     lower, upper = bounds[:, 0], bounds[:, 1]
     if np.any(np.isnan(bounds)) or not np.all(np.isfinite(lower)) or np.any(upper == -np.inf):
-        raise ValueError("mass_bounds: expected finite lower bounds and upper bounds that are "
-                         "finite or inf, got NaN or -inf or an infinite lower bound")
+        raise ValueError(
+            "mass_bounds: expected finite lower bounds and upper bounds that are "
+            "finite or inf, got NaN or -inf or an infinite lower bound"
+        )
     if np.any(lower < 0) or np.any(upper < lower):
-        raise ValueError("mass_bounds: expected 0 <= lower <= upper per link, got "
-                         f"{bounds.tolist()}")
+        raise ValueError(
+            f"mass_bounds: expected 0 <= lower <= upper per link, got {bounds.tolist()}"
+        )
     return lower.copy(), upper.copy()
 
 
@@ -130,8 +144,10 @@ def check_total_mass(value: Any) -> tuple[float, float] | None:
     if bounds.shape == ():
         bounds = np.array([bounds, bounds])
     if bounds.shape != (2,) or bounds[0] > bounds[1] or bounds[1] <= 0 or bounds[0] < 0:
-        raise ValueError(f"total_mass: expected a mass > 0 in kg or (lower, upper) with "
-                         f"0 <= lower <= upper, upper > 0, got {value!r}")
+        raise ValueError(
+            f"total_mass: expected a mass > 0 in kg or (lower, upper) with "
+            f"0 <= lower <= upper, upper > 0, got {value!r}"
+        )
     return float(bounds[0]), float(bounds[1])
 
 

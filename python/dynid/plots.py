@@ -32,8 +32,14 @@ def _save(fig: Figure, path: str | Path) -> Path:
     return path
 
 
-def plot_joint_signals(t: ArrayLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
-                       path: str | Path, title: str = "Joint motion") -> Path:
+def plot_joint_signals(
+    t: ArrayLike,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    path: str | Path,
+    title: str = "Joint motion",
+) -> Path:
     """Positions, velocities and accelerations of all joints (as the paper's Fig. 3)."""
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
     fig.suptitle(title)
@@ -48,8 +54,13 @@ def plot_joint_signals(t: ArrayLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike
     return _save(fig, path)
 
 
-def plot_torques(t: ArrayLike, measured: ArrayLike, predicted: ArrayLike, path: str | Path,
-                 title: str = "Measured and predicted joint torques") -> Path:
+def plot_torques(
+    t: ArrayLike,
+    measured: ArrayLike,
+    predicted: ArrayLike,
+    path: str | Path,
+    title: str = "Measured and predicted joint torques",
+) -> Path:
     """Measured (dashed) against predicted (solid) torque per joint (as the paper's Fig. 4)."""
     measured, predicted = np.asarray(measured), np.asarray(predicted)
     fig, axes = _grid(measured.shape[1], title)
@@ -64,8 +75,12 @@ def plot_torques(t: ArrayLike, measured: ArrayLike, predicted: ArrayLike, path: 
     return _save(fig, path)
 
 
-def plot_residuals(t: ArrayLike, residual: ArrayLike, path: str | Path,
-                   title: str = "Torque residuals (predicted - measured)") -> Path:
+def plot_residuals(
+    t: ArrayLike,
+    residual: ArrayLike,
+    path: str | Path,
+    title: str = "Torque residuals (predicted - measured)",
+) -> Path:
     """The prediction error per joint."""
     residual = np.asarray(residual)
     fig, axes = _grid(residual.shape[1], title)
@@ -79,8 +94,11 @@ def plot_residuals(t: ArrayLike, residual: ArrayLike, path: str | Path,
     return _save(fig, path)
 
 
-def plot_element_comparison(series: dict[str, tuple[ArrayLike, ArrayLike]], path: str | Path,
-                            title: str = "Retrieved and estimated model elements") -> Path:
+def plot_element_comparison(
+    series: dict[str, tuple[ArrayLike, ArrayLike]],
+    path: str | Path,
+    title: str = "Retrieved and estimated model elements",
+) -> Path:
     """Controller values against the identified model's, sample by sample, one panel per
     element, e.g. {"g_2(q)": (retrieved, estimated), "M_11(q)": (...)} (as the paper's Fig. 6)."""
     fig, axes = plt.subplots(1, len(series), figsize=(5.5 * len(series), 3.6), squeeze=False)

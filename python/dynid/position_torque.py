@@ -61,13 +61,16 @@ def position_names(joints: tuple[int, ...]) -> tuple[list[str], list[str]]:
     names, expressions = [], []
     for j in joints:
         names += [f"{SIN_NAME}{j + 1}", f"{COS_NAME}{j + 1}"]
-        expressions += [f"position torque of joint {j + 1}: coefficient of sin q{j + 1}",
-                        f"position torque of joint {j + 1}: coefficient of cos q{j + 1}"]
+        expressions += [
+            f"position torque of joint {j + 1}: coefficient of sin q{j + 1}",
+            f"position torque of joint {j + 1}: coefficient of cos q{j + 1}",
+        ]
     return names, expressions
 
 
-def position_torque_joints(robot: Robot, rotor: bool, friction: bool,
-                           offset: bool) -> tuple[tuple[int, ...], tuple[int, ...]]:
+def position_torque_joints(
+    robot: Robot, rotor: bool, friction: bool, offset: bool
+) -> tuple[tuple[int, ...], tuple[int, ...]]:
     """(kept, left out): the joints (0-based) whose sin q_j, cos q_j columns are structurally
     identifiable next to the base columns of ``robot``'s regressor (with the rotor, friction and
     offset columns asked for), and those that are not (module docstring).

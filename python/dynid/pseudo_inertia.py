@@ -39,8 +39,20 @@ def standard_from_pseudo_inertia(J: NDArray[np.float64]) -> NDArray[np.float64]:
     J = 0.5 * (np.asarray(J, dtype=float) + np.asarray(J, dtype=float).T)
     sigma = J[:3, :3]
     inertia = np.trace(sigma) * np.eye(3) - sigma
-    return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], inertia[0, 0], inertia[0, 1],
-                     inertia[0, 2], inertia[1, 1], inertia[1, 2], inertia[2, 2]])
+    return np.array(
+        [
+            J[3, 3],
+            J[0, 3],
+            J[1, 3],
+            J[2, 3],
+            inertia[0, 0],
+            inertia[0, 1],
+            inertia[0, 2],
+            inertia[1, 1],
+            inertia[1, 2],
+            inertia[2, 2],
+        ]
+    )
 
 
 def nearest_with_margin(J: NDArray[np.float64], margin: float) -> NDArray[np.float64]:

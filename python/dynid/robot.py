@@ -129,8 +129,17 @@ class Robot(_core.Model):
         from .urdf import dh_model_from_urdf  # on first use: import dynid stays fast
 
         model = dh_model_from_urdf(urdf, base_link, tip_link, convention)
-        robot = cls.from_dh(model.dh, model.joint_types, convention, gravity, model.params,
-                            model.base, model.tool, model.qlim, model.name)
+        robot = cls.from_dh(
+            model.dh,
+            model.joint_types,
+            convention,
+            gravity,
+            model.params,
+            model.base,
+            model.tool,
+            model.qlim,
+            model.name,
+        )
         robot.Ia, robot.Fv, robot.Fs = model.Ia, model.Fv, model.Fs
         return robot
 
@@ -224,10 +233,18 @@ class Robot(_core.Model):
     def _state(self) -> dict[str, Any]:
         """Everything that defines the robot (derived caches such as base parameters excluded)."""
         return {
-            "dh": self.dh, "joint_types": self.joint_types, "convention": self.convention,
-            "gravity": self.gravity_vector, "params": self.params, "base": self.base,
-            "tool": self.tool, "qlim": self.qlim, "name": self.name,
-            "Ia": self.Ia, "Fv": self.Fv, "Fs": self.Fs,
+            "dh": self.dh,
+            "joint_types": self.joint_types,
+            "convention": self.convention,
+            "gravity": self.gravity_vector,
+            "params": self.params,
+            "base": self.base,
+            "tool": self.tool,
+            "qlim": self.qlim,
+            "name": self.name,
+            "Ia": self.Ia,
+            "Fv": self.Fv,
+            "Fs": self.Fs,
         }
 
     def __reduce__(self) -> tuple[object, tuple[dict[str, Any]]]:
@@ -239,8 +256,12 @@ class Robot(_core.Model):
         if not isinstance(other, Robot):
             return NotImplemented
         mine, theirs = self._state(), other._state()
-        return all(np.array_equal(mine[k], theirs[k]) if isinstance(mine[k], np.ndarray)
-                   else mine[k] == theirs[k] for k in mine)
+        return all(
+            np.array_equal(mine[k], theirs[k])
+            if isinstance(mine[k], np.ndarray)
+            else mine[k] == theirs[k]
+            for k in mine
+        )
 
     # Unhashable (parameters are settable); mypy objects to None in place of the inherited method.
     __hash__ = None  # type: ignore[assignment]
@@ -248,15 +269,20 @@ class Robot(_core.Model):
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""
         other = Robot.from_dh(
-            self.dh, self.joint_types, self.convention, self.gravity_vector, self.params,
-            self.base, self.tool, self.qlim, self.name,
+            self.dh,
+            self.joint_types,
+            self.convention,
+            self.gravity_vector,
+            self.params,
+            self.base,
+            self.tool,
+            self.qlim,
+            self.name,
         )
         other.Ia, other.Fv, other.Fs = self.Ia, self.Fv, self.Fs
         return other
 
-    def with_payload(
-        self, mass: float, com: ArrayLike, inertia: ArrayLike | None = None
-    ) -> Robot:
+    def with_payload(self, mass: float, com: ArrayLike, inertia: ArrayLike | None = None) -> Robot:
         """A copy carrying a rigid payload on the last link (notes, "Rule of change in dynamic
         parameters").
 
@@ -287,8 +313,10 @@ class Robot(_core.Model):
         with np.errstate(over="ignore", invalid="ignore"):
             params[-1] += payload
         if not np.all(np.isfinite(params[-1])):
-            raise ValueError("com: the payload's parameters about frame n overflow "
-                             "(m |com|^2 is not a finite number); check mass and com")
+            raise ValueError(
+                "com: the payload's parameters about frame n overflow "
+                "(m |com|^2 is not a finite number); check mass and com"
+            )
         other.params = params
         return other
 
@@ -333,9 +361,17 @@ class Robot(_core.Model):
 
 def _robot_from_state(state: dict[str, Any]) -> Robot:
     """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
-    robot = Robot.from_dh(state["dh"], state["joint_types"], state["convention"],
-                          state["gravity"], state["params"], state["base"], state["tool"],
-                          state["qlim"], state["name"])
+    robot = Robot.from_dh(
+        state["dh"],
+        state["joint_types"],
+        state["convention"],
+        state["gravity"],
+        state["params"],
+        state["base"],
+        state["tool"],
+        state["qlim"],
+        state["name"],
+    )
     robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
     return robot
 

@@ -44,7 +44,9 @@ SPIKE_FLOOR = 1e-3
 def _array(x: ArrayLike, name: str, min_ndim: int = 1) -> NDArray[np.float64]:
     arr = real_array(x, name)
     if arr.ndim < min_ndim:
-        raise ValueError(f"{name}: expected at least {min_ndim} dimension(s), got shape {arr.shape}")
+        raise ValueError(
+            f"{name}: expected at least {min_ndim} dimension(s), got shape {arr.shape}"
+        )
     return arr
 
 
@@ -74,7 +76,12 @@ PadType = Literal["odd", "even", "constant"]
 
 
 def _sosfiltfilt(
-    x: NDArray, sos: NDArray, axis: int, order: int, name: str, padtype: PadType = "odd",
+    x: NDArray,
+    sos: NDArray,
+    axis: int,
+    order: int,
+    name: str,
+    padtype: PadType = "odd",
     padlen: int | None = None,
 ) -> NDArray:
     """sosfiltfilt with a readable error when x is shorter than the filter's edge padding."""
@@ -97,7 +104,12 @@ def _sosfiltfilt(
 
 
 def lowpass(
-    x: ArrayLike, fs: float, cutoff: float, order: int = 4, axis: int = 0, padtype: PadType = "odd",
+    x: ArrayLike,
+    fs: float,
+    cutoff: float,
+    order: int = 4,
+    axis: int = 0,
+    padtype: PadType = "odd",
     settle: bool = False,
 ) -> NDArray:
     """Zero-phase low-pass Butterworth filter (forward and backward, ``sosfiltfilt``).

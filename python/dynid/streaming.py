@@ -127,9 +127,8 @@ def least_squares_streaming(
             if index is not None
             else 10 * robot.n + (robot.n if rotor else 0) + (2 * robot.n if friction else 0)
         )
-        shape = (count, robot.n, width)
-        if count is not None and (buffer is None or buffer.shape != shape):
-            buffer = np.empty(shape)
+        if count is not None and (buffer is None or buffer.shape != (count, robot.n, width)):
+            buffer = np.empty((count, robot.n, width))
         Y = robot.regressor(
             q,
             qd,

@@ -17,12 +17,16 @@ def model_summary(robot: Robot) -> str:
         f"gravity {np.round(robot.gravity_vector, 6).tolist()}"
     ]
     heads = ("a_{i-1}", "alpha_{i-1}") if robot.convention == "modified" else ("a", "alpha")
-    lines.append(f"  {'row':<4}{'type':<5}{heads[0]:>10}  {heads[1]:>16}  {'d':>10}  "
-                 f"{'theta':>10}  {'qmin':>8}  {'qmax':>8}")
+    lines.append(
+        f"  {'row':<4}{'type':<5}{heads[0]:>10}  {heads[1]:>16}  {'d':>10}  "
+        f"{'theta':>10}  {'qmin':>8}  {'qmax':>8}"
+    )
     for i, (row, kind, lim) in enumerate(zip(robot.dh, robot.joint_types, robot.qlim)):
         alpha = f"{row[1]:.6g} ({np.degrees(row[1]):.4g}°)"
-        lines.append(f"  {i + 1:<4}{kind:<5}{row[0]:>10.6g}  {alpha:>16}  {row[2]:>10.6g}  "
-                     f"{row[3]:>10.6g}  {lim[0]:>8.4g}  {lim[1]:>8.4g}")
+        lines.append(
+            f"  {i + 1:<4}{kind:<5}{row[0]:>10.6g}  {alpha:>16}  {row[2]:>10.6g}  "
+            f"{row[3]:>10.6g}  {lim[0]:>8.4g}  {lim[1]:>8.4g}"
+        )
     for key in ("base", "tool"):
         value = np.asarray(getattr(robot, key))
         if not np.array_equal(value, np.eye(4)):
@@ -39,12 +43,16 @@ def model_summary(robot: Robot) -> str:
         lines.append(f"  {key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, key)))
     counts = [
         (label, base_parameters(robot, "torque", rotor=rotor, friction=friction).count)
-        for label, rotor, friction in (("rigid body", False, False), ("+ rotor", True, False),
-                                       ("+ friction", False, True),
-                                       ("+ rotor + friction", True, True))
+        for label, rotor, friction in (
+            ("rigid body", False, False),
+            ("+ rotor", True, False),
+            ("+ friction", False, True),
+            ("+ rotor + friction", True, True),
+        )
     ]
     lines.append(
-        "base parameters: torque " + ", ".join(f"{c} ({label})" for label, c in counts)
+        "base parameters: torque "
+        + ", ".join(f"{c} ({label})" for label, c in counts)
         + f"; gravity {base_parameters(robot, 'gravity').count}; inertia "
         f"{base_parameters(robot, 'inertia').count}"
     )

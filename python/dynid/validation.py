@@ -40,8 +40,11 @@ def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArra
     rms_measured = np.sqrt(np.mean(y**2, axis=0))
     with np.errstate(divide="ignore", invalid="ignore"):
         r2 = np.where(sst > 0.0, 1.0 - sse / sst, np.where(sse == 0.0, 1.0, -np.inf))
-        relative = np.where(rms_measured > 0.0, np.sqrt(np.mean(error**2, axis=0)) / rms_measured,
-                            np.where(sse == 0.0, 0.0, np.inf))
+        relative = np.where(
+            rms_measured > 0.0,
+            np.sqrt(np.mean(error**2, axis=0)) / rms_measured,
+            np.where(sse == 0.0, 0.0, np.inf),
+        )
     with np.errstate(over="ignore"):
         mse = np.ldexp(np.mean(error**2, axis=0), 2 * exponent)
     if not np.all(np.isfinite(mse)):

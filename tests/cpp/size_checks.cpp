@@ -123,26 +123,38 @@ int main() {
   expect_rejected("coriolis", "qd", [&] { dynid::coriolis(model, ws, q, long_vector, out); });
   expect_rejected("coriolis", "c", [&] { dynid::coriolis(model, ws, q, qd, long_out); });
 
-  expect_rejected("coriolis_matrix", "ws", [&] { dynid::coriolis_matrix(model, ws_other, q, qd, S); });
-  expect_rejected("coriolis_matrix", "q", [&] { dynid::coriolis_matrix(model, ws, short_vector, qd, S); });
-  expect_rejected("coriolis_matrix", "qd", [&] { dynid::coriolis_matrix(model, ws, q, short_vector, S); });
-  expect_rejected("coriolis_matrix", "S", [&] { dynid::coriolis_matrix(model, ws, q, qd, wrong_rows); });
+  expect_rejected("coriolis_matrix", "ws",
+                  [&] { dynid::coriolis_matrix(model, ws_other, q, qd, S); });
+  expect_rejected("coriolis_matrix", "q",
+                  [&] { dynid::coriolis_matrix(model, ws, short_vector, qd, S); });
+  expect_rejected("coriolis_matrix", "qd",
+                  [&] { dynid::coriolis_matrix(model, ws, q, short_vector, S); });
+  expect_rejected("coriolis_matrix", "S",
+                  [&] { dynid::coriolis_matrix(model, ws, q, qd, wrong_rows); });
 
   expect_rejected("friction", "qd", [&] { dynid::friction(model, short_vector, out); });
   expect_rejected("friction", "tau", [&] { dynid::friction(model, qd, long_out); });
 
   VectorX qdd_out(n);
-  expect_rejected("forward_dynamics", "ws", [&] { dynid::forward_dynamics(model, ws_other, q, qd, tau, qdd_out); });
-  expect_rejected("forward_dynamics", "q", [&] { dynid::forward_dynamics(model, ws, short_vector, qd, tau, qdd_out); });
-  expect_rejected("forward_dynamics", "qd", [&] { dynid::forward_dynamics(model, ws, q, long_vector, tau, qdd_out); });
-  expect_rejected("forward_dynamics", "tau", [&] { dynid::forward_dynamics(model, ws, q, qd, short_vector, qdd_out); });
-  expect_rejected("forward_dynamics", "qdd", [&] { dynid::forward_dynamics(model, ws, q, qd, tau, short_out); });
+  expect_rejected("forward_dynamics", "ws",
+                  [&] { dynid::forward_dynamics(model, ws_other, q, qd, tau, qdd_out); });
+  expect_rejected("forward_dynamics", "q",
+                  [&] { dynid::forward_dynamics(model, ws, short_vector, qd, tau, qdd_out); });
+  expect_rejected("forward_dynamics", "qd",
+                  [&] { dynid::forward_dynamics(model, ws, q, long_vector, tau, qdd_out); });
+  expect_rejected("forward_dynamics", "tau",
+                  [&] { dynid::forward_dynamics(model, ws, q, qd, short_vector, qdd_out); });
+  expect_rejected("forward_dynamics", "qdd",
+                  [&] { dynid::forward_dynamics(model, ws, q, qd, tau, short_out); });
 
   expect_rejected("kinetic_energy", "ws", [&] { dynid::kinetic_energy(model, ws_other, q, qd); });
-  expect_rejected("kinetic_energy", "q", [&] { dynid::kinetic_energy(model, ws, short_vector, qd); });
-  expect_rejected("kinetic_energy", "qd", [&] { dynid::kinetic_energy(model, ws, q, long_vector); });
+  expect_rejected("kinetic_energy", "q",
+                  [&] { dynid::kinetic_energy(model, ws, short_vector, qd); });
+  expect_rejected("kinetic_energy", "qd",
+                  [&] { dynid::kinetic_energy(model, ws, q, long_vector); });
   expect_rejected("potential_energy", "ws", [&] { dynid::potential_energy(model, ws_other, q); });
-  expect_rejected("potential_energy", "q", [&] { dynid::potential_energy(model, ws, long_vector); });
+  expect_rejected("potential_energy", "q",
+                  [&] { dynid::potential_energy(model, ws, long_vector); });
 
   MatrixX T_wrong(3, 4), J_wrong(6, n + 1);
   expect_rejected("fkine", "ws", [&] { dynid::fkine(model, ws_other, q, T); });
@@ -153,19 +165,31 @@ int main() {
   expect_rejected("jacobian", "J", [&] { dynid::jacobian(model, ws, q, J_wrong); });
 
   RowMajorMatrixX Y_without_friction(n, dynid::regressor_columns(n, true, false));
-  expect_rejected("regressor", "ws", [&] { dynid::regressor(model, ws_other, q, qd, qdd, true, true, Y); });
-  expect_rejected("regressor", "q", [&] { dynid::regressor(model, ws, short_vector, qd, qdd, true, true, Y); });
-  expect_rejected("regressor", "qd", [&] { dynid::regressor(model, ws, q, short_vector, qdd, true, true, Y); });
-  expect_rejected("regressor", "qdd", [&] { dynid::regressor(model, ws, q, qd, long_vector, true, true, Y); });
-  expect_rejected("regressor", "Y", [&] { dynid::regressor(model, ws, q, qd, qdd, true, true, Y_without_friction); });
-  expect_rejected("regressor", "Y", [&] { dynid::regressor(model, ws, q, qd, qdd, false, false, Y); });
+  expect_rejected("regressor", "ws",
+                  [&] { dynid::regressor(model, ws_other, q, qd, qdd, true, true, Y); });
+  expect_rejected("regressor", "q",
+                  [&] { dynid::regressor(model, ws, short_vector, qd, qdd, true, true, Y); });
+  expect_rejected("regressor", "qd",
+                  [&] { dynid::regressor(model, ws, q, short_vector, qdd, true, true, Y); });
+  expect_rejected("regressor", "qdd",
+                  [&] { dynid::regressor(model, ws, q, qd, long_vector, true, true, Y); });
+  expect_rejected("regressor", "Y",
+                  [&] { dynid::regressor(model, ws, q, qd, qdd, true, true, Y_without_friction); });
+  expect_rejected("regressor", "Y",
+                  [&] { dynid::regressor(model, ws, q, qd, qdd, false, false, Y); });
   RowMajorMatrixX Yg_wrong(n, 10 * n - 1), Ym_wrong(n * (n + 1) / 2, 10 * n);
-  expect_rejected("gravity_regressor", "ws", [&] { dynid::gravity_regressor(model, ws_other, q, Yg); });
-  expect_rejected("gravity_regressor", "q", [&] { dynid::gravity_regressor(model, ws, short_vector, Yg); });
-  expect_rejected("gravity_regressor", "Yg", [&] { dynid::gravity_regressor(model, ws, q, Yg_wrong); });
-  expect_rejected("inertia_regressor", "ws", [&] { dynid::inertia_regressor(model, ws_other, q, true, Ym); });
-  expect_rejected("inertia_regressor", "q", [&] { dynid::inertia_regressor(model, ws, long_vector, true, Ym); });
-  expect_rejected("inertia_regressor", "Ym", [&] { dynid::inertia_regressor(model, ws, q, true, Ym_wrong); });
+  expect_rejected("gravity_regressor", "ws",
+                  [&] { dynid::gravity_regressor(model, ws_other, q, Yg); });
+  expect_rejected("gravity_regressor", "q",
+                  [&] { dynid::gravity_regressor(model, ws, short_vector, Yg); });
+  expect_rejected("gravity_regressor", "Yg",
+                  [&] { dynid::gravity_regressor(model, ws, q, Yg_wrong); });
+  expect_rejected("inertia_regressor", "ws",
+                  [&] { dynid::inertia_regressor(model, ws_other, q, true, Ym); });
+  expect_rejected("inertia_regressor", "q",
+                  [&] { dynid::inertia_regressor(model, ws, long_vector, true, Ym); });
+  expect_rejected("inertia_regressor", "Ym",
+                  [&] { dynid::inertia_regressor(model, ws, q, true, Ym_wrong); });
 
   // The model's setters and the RLS name their arguments too (the function is the class's).
   dynid::Model editable = model;
@@ -177,29 +201,58 @@ int main() {
   expect_rejected("Model", "i", [&] { (void)editable.link_inconsistency(-1); }, false);
   dynid::RecursiveLeastSquares rls(4);
   const MatrixX block = MatrixX::Ones(2, 4);
-  expect_rejected("RecursiveLeastSquares", "Y_k", [&] { rls.update(MatrixX::Ones(2, 5), VectorX::Ones(2)); }, false);
-  expect_rejected("RecursiveLeastSquares", "tau_k", [&] { rls.update(block, VectorX::Ones(3)); }, false);
-  expect_rejected("RecursiveLeastSquares", "P", [&] { MatrixX P(4, 3); rls.covariance(P); }, false);
-  expect_rejected("RecursiveLeastSquares", "theta0", [&] { rls.reset(VectorX::Zero(3), MatrixX::Identity(4, 4)); }, false);
-  expect_rejected("RecursiveLeastSquares", "P0", [&] { rls.reset(VectorX::Zero(4), MatrixX::Identity(3, 3)); }, false);
+  expect_rejected(
+      "RecursiveLeastSquares", "Y_k", [&] { rls.update(MatrixX::Ones(2, 5), VectorX::Ones(2)); },
+      false);
+  expect_rejected(
+      "RecursiveLeastSquares", "tau_k", [&] { rls.update(block, VectorX::Ones(3)); }, false);
+  expect_rejected(
+      "RecursiveLeastSquares", "P",
+      [&] {
+        MatrixX P(4, 3);
+        rls.covariance(P);
+      },
+      false);
+  expect_rejected(
+      "RecursiveLeastSquares", "theta0",
+      [&] { rls.reset(VectorX::Zero(3), MatrixX::Identity(4, 4)); }, false);
+  expect_rejected(
+      "RecursiveLeastSquares", "P0", [&] { rls.reset(VectorX::Zero(4), MatrixX::Identity(3, 3)); },
+      false);
 
   MatrixX Jdot(6, n), Jdot_wrong(6, n - 1), dtau_dq(n, n), dtau_dqd(n, n);
   expect_rejected("jacobian_dot", "ws", [&] { dynid::jacobian_dot(model, ws_other, q, qd, Jdot); });
-  expect_rejected("jacobian_dot", "q", [&] { dynid::jacobian_dot(model, ws, short_vector, qd, Jdot); });
-  expect_rejected("jacobian_dot", "qd", [&] { dynid::jacobian_dot(model, ws, q, long_vector, Jdot); });
-  expect_rejected("jacobian_dot", "Jdot", [&] { dynid::jacobian_dot(model, ws, q, qd, Jdot_wrong); });
-  expect_rejected("rnea_derivatives", "ws", [&] { dynid::rnea_derivatives(model, ws_other, q, qd, qdd, dtau_dq, dtau_dqd); });
-  expect_rejected("rnea_derivatives", "q", [&] { dynid::rnea_derivatives(model, ws, long_vector, qd, qdd, dtau_dq, dtau_dqd); });
-  expect_rejected("rnea_derivatives", "qd", [&] { dynid::rnea_derivatives(model, ws, q, short_vector, qdd, dtau_dq, dtau_dqd); });
-  expect_rejected("rnea_derivatives", "qdd", [&] { dynid::rnea_derivatives(model, ws, q, qd, short_vector, dtau_dq, dtau_dqd); });
-  expect_rejected("rnea_derivatives", "dtau_dq", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, wrong_rows, dtau_dqd); });
-  expect_rejected("rnea_derivatives", "dtau_dqd", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, dtau_dq, wrong_square); });
+  expect_rejected("jacobian_dot", "q",
+                  [&] { dynid::jacobian_dot(model, ws, short_vector, qd, Jdot); });
+  expect_rejected("jacobian_dot", "qd",
+                  [&] { dynid::jacobian_dot(model, ws, q, long_vector, Jdot); });
+  expect_rejected("jacobian_dot", "Jdot",
+                  [&] { dynid::jacobian_dot(model, ws, q, qd, Jdot_wrong); });
+  expect_rejected("rnea_derivatives", "ws",
+                  [&] { dynid::rnea_derivatives(model, ws_other, q, qd, qdd, dtau_dq, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "q", [&] {
+    dynid::rnea_derivatives(model, ws, long_vector, qd, qdd, dtau_dq, dtau_dqd);
+  });
+  expect_rejected("rnea_derivatives", "qd", [&] {
+    dynid::rnea_derivatives(model, ws, q, short_vector, qdd, dtau_dq, dtau_dqd);
+  });
+  expect_rejected("rnea_derivatives", "qdd", [&] {
+    dynid::rnea_derivatives(model, ws, q, qd, short_vector, dtau_dq, dtau_dqd);
+  });
+  expect_rejected("rnea_derivatives", "dtau_dq",
+                  [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, wrong_rows, dtau_dqd); });
+  expect_rejected("rnea_derivatives", "dtau_dqd",
+                  [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, dtau_dq, wrong_square); });
 
   dynid::Simulator simulator(model, dynid::SimulationSettings{});
-  expect_rejected("Simulator::acceleration", "q", [&] { simulator.acceleration(short_vector, qd, tau, qdd_out); });
-  expect_rejected("Simulator::acceleration", "qd", [&] { simulator.acceleration(q, long_vector, tau, qdd_out); });
-  expect_rejected("Simulator::acceleration", "tau", [&] { simulator.acceleration(q, qd, short_vector, qdd_out); });
-  expect_rejected("Simulator::acceleration", "qdd", [&] { simulator.acceleration(q, qd, tau, short_out); });
+  expect_rejected("Simulator::acceleration", "q",
+                  [&] { simulator.acceleration(short_vector, qd, tau, qdd_out); });
+  expect_rejected("Simulator::acceleration", "qd",
+                  [&] { simulator.acceleration(q, long_vector, tau, qdd_out); });
+  expect_rejected("Simulator::acceleration", "tau",
+                  [&] { simulator.acceleration(q, qd, short_vector, qdd_out); });
+  expect_rejected("Simulator::acceleration", "qdd",
+                  [&] { simulator.acceleration(q, qd, tau, short_out); });
 
   // ---- the right sizes work, and agree with independent routes ----
   dynid::rnea(model, ws, q, qd, qdd, tau);
@@ -209,7 +262,8 @@ int main() {
   dynid::gravity(model, ws, q, g);
   dynid::coriolis(model, ws, q, qd, c);
   dynid::friction(model, qd, f);
-  expect_close("rnea = M qdd + S qd + g + friction", (M * qdd + S * qd + g + f - tau).cwiseAbs().maxCoeff());
+  expect_close("rnea = M qdd + S qd + g + friction",
+               (M * qdd + S * qd + g + f - tau).cwiseAbs().maxCoeff());
   expect_close("coriolis = S qd", (S * qd - c).cwiseAbs().maxCoeff());
   dynid::forward_dynamics(model, ws, q, qd, tau, qdd_out);
   expect_close("forward_dynamics(rnea) = qdd", (qdd_out - qdd).cwiseAbs().maxCoeff());
@@ -231,15 +285,19 @@ int main() {
   const VectorX m_stack = Ym * pi.head(11 * n);
   double inertia_error = 0.0;
   for (int i = 0, row = 0; i < n; ++i)
-    for (int k = 0; k <= i; ++k, ++row) inertia_error = std::max(inertia_error, std::abs(m_stack[row] - M(i, k)));
+    for (int k = 0; k <= i; ++k, ++row)
+      inertia_error = std::max(inertia_error, std::abs(m_stack[row] - M(i, k)));
   expect_close("inertia_regressor pi = tril(M)", inertia_error);
   const double kinetic = dynid::kinetic_energy(model, ws, q, qd);
   expect_close("2 T = qd^T M qd", std::abs(2.0 * kinetic - qd.dot(M * qd)));
-  expect_close("potential energy finite", std::isfinite(dynid::potential_energy(model, ws, q)) ? 0.0 : 1.0);
+  expect_close("potential energy finite",
+               std::isfinite(dynid::potential_energy(model, ws, q)) ? 0.0 : 1.0);
   dynid::fkine(model, ws, q, T);
-  expect_close("fkine: homogeneous last row", (T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff());
+  expect_close("fkine: homogeneous last row",
+               (T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff());
   dynid::jacobian(model, ws, q, J);
-  expect_close("jacobian: the prismatic joint has no angular column", J.col(1).tail<3>().cwiseAbs().maxCoeff());
+  expect_close("jacobian: the prismatic joint has no angular column",
+               J.col(1).tail<3>().cwiseAbs().maxCoeff());
   rls.update(block, VectorX::Ones(2));
   MatrixX P_out(4, 4);
   rls.covariance(P_out);

@@ -10,7 +10,8 @@
 // the counters do not see a deliberate allocation.
 //
 // Build (from the repository root):
-//   g++ -O3 -DNDEBUG -std=c++17 -I cpp/include -I cpp/examples -I <eigen3> tests/cpp/test_rls_no_allocation.cpp
+//   g++ -O3 -DNDEBUG -std=c++17 -I cpp/include -I cpp/examples -I <eigen3>
+//   tests/cpp/test_rls_no_allocation.cpp
 //       cpp/src/recursive_least_squares.cpp
 // (tests/test_recursive.py does this and runs it.)
 #include <algorithm>

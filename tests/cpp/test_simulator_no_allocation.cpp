@@ -56,14 +56,16 @@ Model lwr_like() {
 struct Buffers {
   std::vector<double> q, qd, qdd, tau, q_measured;
   explicit Buffers(int rows)
-      : q(rows * kJoints), qd(rows * kJoints), qdd(rows * kJoints), tau(rows * kJoints),
+      : q(rows * kJoints),
+        qd(rows * kJoints),
+        qdd(rows * kJoints),
+        tau(rows * kJoints),
         q_measured(rows * kJoints) {}
   SimulationOutput output(int rows) {
-    return SimulationOutput{RowMajorMap(q.data(), rows, kJoints),
-                            RowMajorMap(qd.data(), rows, kJoints),
-                            RowMajorMap(qdd.data(), rows, kJoints),
-                            RowMajorMap(tau.data(), rows, kJoints),
-                            RowMajorMap(q_measured.data(), rows, kJoints)};
+    return SimulationOutput{
+        RowMajorMap(q.data(), rows, kJoints), RowMajorMap(qd.data(), rows, kJoints),
+        RowMajorMap(qdd.data(), rows, kJoints), RowMajorMap(tau.data(), rows, kJoints),
+        RowMajorMap(q_measured.data(), rows, kJoints)};
   }
 };
 

@@ -33,11 +33,12 @@ dynid::Model make_arm() {
   dynid::Matrix4 base = dynid::Matrix4::Identity(), tool = dynid::Matrix4::Identity();
   base(0, 3) = 0.2;
   tool(2, 3) = 0.1;
-  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base, tool);
+  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base,
+                     tool);
   for (int i = 0; i < n; ++i) {
     dynid::Matrix3 inertia = dynid::Matrix3::Identity() * (0.02 + 0.001 * i);
-    model.set_link(i, dynid::RigidBodyParameters::from_physical(2.0 - 0.2 * i,
-                                                                dynid::Vector3(0.01, -0.02, 0.05), inertia));
+    model.set_link(i, dynid::RigidBodyParameters::from_physical(
+                          2.0 - 0.2 * i, dynid::Vector3(0.01, -0.02, 0.05), inertia));
   }
   model.set_rotor_inertia(dynid::VectorX::Constant(n, 0.1));
   model.set_viscous_friction(dynid::VectorX::Constant(n, 0.5));
@@ -108,8 +109,10 @@ int main() {
   bool ok = true;
   ok &= names_argument("qd", [&] { dynid::rnea_derivatives(model, ws, q, short_v, qdd, dq, dqd); });
   ok &= names_argument("qdd", [&] { dynid::rnea_derivatives(model, ws, q, qd, short_v, dq, dqd); });
-  ok &= names_argument("dtau_dq", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, wrong, dqd); });
-  ok &= names_argument("dtau_dqd", [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, dq, wrong); });
+  ok &= names_argument("dtau_dq",
+                       [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, wrong, dqd); });
+  ok &= names_argument("dtau_dqd",
+                       [&] { dynid::rnea_derivatives(model, ws, q, qd, qdd, dq, wrong); });
   ok &= names_argument("q", [&] { dynid::rnea_derivatives(model, ws, short_v, qd, qdd, dq, dqd); });
   ok &= names_argument("Jdot", [&] { dynid::jacobian_dot(model, ws, q, qd, wrong_J); });
   ok &= names_argument("qd", [&] { dynid::jacobian_dot(model, ws, q, short_v, Jdot); });

@@ -27,8 +27,8 @@ enum class Convention { Standard, Modified };
 enum class JointType { Revolute, Prismatic };
 
 // One DH row. Standard: A_{i-1,i} = Rz(theta) Tz(d) Tx(a) Rx(alpha).
-// Modified: the row holds (a_{i-1}, alpha_{i-1}, d_i, theta_i), A = Rx(alpha) Tx(a) Rz(theta) Tz(d).
-// The joint variable adds to theta (revolute) or d (prismatic).
+// Modified: the row holds (a_{i-1}, alpha_{i-1}, d_i, theta_i), A = Rx(alpha) Tx(a) Rz(theta)
+// Tz(d). The joint variable adds to theta (revolute) or d (prismatic).
 struct DHRow {
   double a = 0.0;
   double alpha = 0.0;
@@ -39,8 +39,9 @@ struct DHRow {
 
 class Model {
  public:
-  Model(std::vector<DHRow> rows, Convention convention, const Vector3& gravity = Vector3(0, 0, -9.81),
-        const Matrix4& base = Matrix4::Identity(), const Matrix4& tool = Matrix4::Identity());
+  Model(std::vector<DHRow> rows, Convention convention,
+        const Vector3& gravity = Vector3(0, 0, -9.81), const Matrix4& base = Matrix4::Identity(),
+        const Matrix4& tool = Matrix4::Identity());
 
   int n() const { return n_; }
   Convention convention() const { return convention_; }

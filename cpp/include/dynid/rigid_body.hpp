@@ -19,7 +19,8 @@ struct RigidBodyParameters {
 
   // Physical form: mass, centre of mass and inertia about the centre of mass, all in the
   // frame's axes; Steiner's theorem I = I_c + m (|r|^2 E - r r^T) (notes, "Dynamic parameters 2").
-  static RigidBodyParameters from_physical(double mass, const Vector3& com, const Matrix3& inertia_com);
+  static RigidBodyParameters from_physical(double mass, const Vector3& com,
+                                           const Matrix3& inertia_com);
 
   // The same body described in frame A, when these parameters are about frame B and
   // x_A = R x_B + p. Linear in (m, h, I): rotation plus the generalised Steiner terms.

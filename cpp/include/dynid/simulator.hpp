@@ -16,7 +16,7 @@
 namespace dynid {
 
 enum class Integrator {
-  RungeKutta4,        // classical fourth-order Runge-Kutta, global error O(h^4)
+  RungeKutta4,  // classical fourth-order Runge-Kutta, global error O(h^4)
   // qd += h qdd(q, qd); q += h qd, global error O(h); symplectic (bounded energy error) when M
   // is constant, nearly so otherwise (docs: simulation part of uses.md)
   SemiImplicitEuler,

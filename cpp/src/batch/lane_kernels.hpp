@@ -40,11 +40,21 @@ inline void sincos_lanes(V x, V& s, V& c) {
   r = r - k * kPiOver2Part3;
   const V z = r * r;
   const V ps = ((((1.58962301576546568060E-10 * z - 2.50507477628578072866E-8) * z +
-                  2.75573136213857245213E-6) * z - 1.98412698295895385996E-4) * z +
-                8.33333333332211858878E-3) * z - 1.66666666666666307295E-1;
+                  2.75573136213857245213E-6) *
+                     z -
+                 1.98412698295895385996E-4) *
+                    z +
+                8.33333333332211858878E-3) *
+                   z -
+               1.66666666666666307295E-1;
   const V pc = ((((-1.13585365213876817300E-11 * z + 2.08757008419747316778E-9) * z -
-                  2.75573141792967388112E-7) * z + 2.48015872888517045348E-5) * z -
-                1.38888888888730564116E-3) * z + 4.16666666666665929218E-2;
+                  2.75573141792967388112E-7) *
+                     z +
+                 2.48015872888517045348E-5) *
+                    z -
+                1.38888888888730564116E-3) *
+                   z +
+               4.16666666666665929218E-2;
   const V sr = r + r * z * ps;
   const V cr = (1.0 - 0.5 * z) + z * z * pc;
   // Quadrant k mod 4: sin = (s, c, -s, -c), cos = (c, -s, -c, s).
@@ -161,9 +171,7 @@ inline long store(const V* values, int width, double* out, long t0, int count) {
   return -1;
 }
 
-inline V sign(const V& x) {
-  return __builtin_convertvector((Bits)(x < 0.0) - (Bits)(x > 0.0), V);
-}
+inline V sign(const V& x) { return __builtin_convertvector((Bits)(x < 0.0) - (Bits)(x > 0.0), V); }
 
 // ------------------------------------------------------------------------------- the kernels
 // Backward pass of accumulate_wrenches (rnea.cpp): link i's wrench added to its parent's, and
@@ -270,7 +278,8 @@ inline void add_to_parent(const Joint& X, const Composite& c, Composite& parent)
   const V3 hr = rotate_to_parent(X, c.h);
   const V3& p = X.p;
   const V m = c.m;
-  const V k = 2.0 * (p.x * hr.x + p.y * hr.y + p.z * hr.z) + m * (p.x * p.x + p.y * p.y + p.z * p.z);
+  const V k =
+      2.0 * (p.x * hr.x + p.y * hr.y + p.z * hr.z) + m * (p.x * p.x + p.y * p.y + p.z * p.z);
   R[0] += k - 2.0 * hr.x * p.x - m * p.x * p.x;
   R[3] += k - 2.0 * hr.y * p.y - m * p.y * p.y;
   R[5] += k - 2.0 * hr.z * p.z - m * p.z * p.z;
@@ -308,8 +317,7 @@ long mass_matrix(const BatchModel& bm, const double* q, double* M, long T) {
         mu = {c.h.y, -c.h.x, zero};
         f = {zero, zero, c.m};
       }
-      B[(i - 1) * n + (i - 1)] =
-          (bm.joints[i - 1].revolute ? mu.z : f.z) + bm.joints[i - 1].Ia;
+      B[(i - 1) * n + (i - 1)] = (bm.joints[i - 1].revolute ? mu.z : f.z) + bm.joints[i - 1].Ia;
       for (int j = i - 1; j >= 1; --j) {
         const Joint& Xj = X[j + 1];
         f = rotate_to_parent(Xj, f);

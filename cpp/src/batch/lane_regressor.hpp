@@ -124,7 +124,7 @@ long regressor(const BatchModel& bm, const double* q, const double* qd, const do
   const int n = bm.n;
   const int P = 10 * n + (rotor ? n : 0) + (friction ? 2 * n : 0);
   Joint X[n + 1];
-  V d[n + 1];    // joint offsets along z (prismatic: q + d)
+  V d[n + 1];     // joint offsets along z (prismatic: q + d)
   V U[n + 1][6];  // joint axes in the current link's parameter frame
   V out[n * P];
   for (long t0 = 0; t0 < T; t0 += W) {
@@ -163,7 +163,8 @@ long regressor(const BatchModel& bm, const double* q, const double* qd, const do
         for (int i = 1; i < j; ++i) axis_through_joint_to_link(X[j], d[j], J, U[i]);
         // axis_to_link: reference point to (a, 0, 0), then Rx(-alpha).
         const V3 s = offset_to_link(J, {own[0], own[1], own[2]});
-        const V3 l = offset_to_link(J, {own[3], own[4] + J.offset_a * own[2], own[5] - J.offset_a * own[1]});
+        const V3 l =
+            offset_to_link(J, {own[3], own[4] + J.offset_a * own[2], own[5] - J.offset_a * own[1]});
         own[0] = s.x, own[1] = s.y, own[2] = s.z, own[3] = l.x, own[4] = l.y, own[5] = l.z;
       }
       // Link j's motion in its parameter frame (motion_in_link_frame) and its blocks Y_ij.

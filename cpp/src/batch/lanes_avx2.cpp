@@ -6,7 +6,10 @@
 #include "lane_regressor.hpp"
 
 namespace dynid::detail {
-const LaneKernels lanes_avx2 = {"avx2", 4, &lanes_avx2_impl::rnea, &lanes_avx2_impl::gravity,
+const LaneKernels lanes_avx2 = {"avx2",
+                                4,
+                                &lanes_avx2_impl::rnea,
+                                &lanes_avx2_impl::gravity,
                                 &lanes_avx2_impl::mass_matrix,
                                 &lanes_avx2_impl::regressor,
                                 &lanes_avx2_impl::sincos_many};

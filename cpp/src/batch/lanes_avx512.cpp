@@ -6,8 +6,11 @@
 #include "lane_regressor.hpp"
 
 namespace dynid::detail {
-const LaneKernels lanes_avx512 = {"avx512", 8, &lanes_avx512_impl::rnea, &lanes_avx512_impl::gravity,
-                                &lanes_avx512_impl::mass_matrix,
-                                &lanes_avx512_impl::regressor,
-                                &lanes_avx512_impl::sincos_many};
+const LaneKernels lanes_avx512 = {"avx512",
+                                  8,
+                                  &lanes_avx512_impl::rnea,
+                                  &lanes_avx512_impl::gravity,
+                                  &lanes_avx512_impl::mass_matrix,
+                                  &lanes_avx512_impl::regressor,
+                                  &lanes_avx512_impl::sincos_many};
 }  // namespace dynid::detail

@@ -56,16 +56,26 @@ def identify(args: argparse.Namespace) -> None:
         raise ValueError("--prior, --prior-weight: only with --physical")
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
-    step(f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
-         + (f" (first {args.skip} skipped)" if args.skip else ""))
+    step(
+        f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
+        + (f" (first {args.skip} skipped)" if args.skip else "")
+    )
     robot = load_model(args.model)
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
-    result = identify_log(log, robot, rotor=args.rotor, friction=args.friction,
-                          offset=args.offset, method=args.method,
-                          preparation=preparation_options(args), physical=args.physical,
-                          prior=args.prior, prior_weight=args.prior_weight,
-                          position_torque=args.position_torque)
-    new_notes = result.training["notes"][len(log.notes):]
+    result = identify_log(
+        log,
+        robot,
+        rotor=args.rotor,
+        friction=args.friction,
+        offset=args.offset,
+        method=args.method,
+        preparation=preparation_options(args),
+        physical=args.physical,
+        prior=args.prior,
+        prior_weight=args.prior_weight,
+        position_torque=args.position_torque,
+    )
+    new_notes = result.training["notes"][len(log.notes) :]
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
     print(result.summary(), flush=True)
@@ -85,16 +95,26 @@ def validate(args: argparse.Namespace) -> None:
     result = load_result(args.result)
     log = load_log(args.log, **log_options(args))
     validation = run_validation(result, log, preparation=preparation_options(args))
-    step(f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
-         f"log {args.log}: {validation.log.T} samples")
+    step(
+        f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
+        f"log {args.log}: {validation.log.T} samples"
+    )
     for note in validation.notes:
         print(f"note: {note} (--cutoff)", flush=True)
     step("predicted the torques")
-    print(validation_table(validation.metrics,
-                           training_relative_rms=result.training.get("metrics", {}).get(
-                               "relative_rms")))
-    path = save_validation(validation, args.output, result_source=str(args.result),
-                           log_source=str(args.log), overwrite=args.overwrite)
+    print(
+        validation_table(
+            validation.metrics,
+            training_relative_rms=result.training.get("metrics", {}).get("relative_rms"),
+        )
+    )
+    path = save_validation(
+        validation,
+        args.output,
+        result_source=str(args.result),
+        log_source=str(args.log),
+        overwrite=args.overwrite,
+    )
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
 
 

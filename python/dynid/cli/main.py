@@ -29,8 +29,14 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"dynid {args.command}: interrupted", file=sys.stderr)
         return 130
-    except (ValueError, OSError, OverflowError, MemoryError, RecursionError,
-            PhysicalIdentificationError) as exc:
+    except (
+        ValueError,
+        OSError,
+        OverflowError,
+        MemoryError,
+        RecursionError,
+        PhysicalIdentificationError,
+    ) as exc:
         # A user error (a file, a field, a value): one line naming it, never a traceback.
         # RecursionError: absurdly deep nesting in a JSON/YAML file; MemoryError: a file
         # asking for more than the machine has.

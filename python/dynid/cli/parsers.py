@@ -38,62 +38,103 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_identify(subcommands: Any) -> None:
     p = subcommands.add_parser(
-        "identify", help="identify the base parameters on a measurement log (docs/cli.md)",
+        "identify",
+        help="identify the base parameters on a measurement log (docs/cli.md)",
         description="Identify the base dynamic parameters of a DH model on a log (NPZ or CSV, "
         "docs/data.md) by least squares; write result.json and PNG plots.",
     )
     p.add_argument("log", help="measurement log, .npz or .csv")
     _add_model(p)
     p.add_argument("--rotor", action="store_true", help="add the rotor inertia columns Ia")
-    p.add_argument("--friction", action="store_true",
-                   help="add viscous and Coulomb friction columns Fv, Fs")
-    p.add_argument("--offset", action="store_true",
-                   help="add a constant torque (sensor offset) per joint")
-    p.add_argument("--position-torque", action="store_true",
-                   help="add a torque ks_j sin q_j + kc_j cos q_j per joint (sensor/gear ripple "
-                   "once per turn, cable or spring stiffness), on the joints where it is "
-                   "distinguishable from gravity (docs/identification.md)")
-    p.add_argument("--method", choices=("ols", "wls"), default="wls",
-                   help="ordinary or weighted (per-joint noise) least squares (default wls)")
-    p.add_argument("--physical", action="store_true",
-                   help="physically consistent fit (SDP: every link a possible rigid body, "
-                   "Ia, Fv, Fs >= 0); the result holds a full robot (docs/identification.md)")
-    p.add_argument("--prior", metavar="MODEL|URDF",
-                   help="with --physical: the model (built-in name, model file or URDF) whose "
-                   "parameters fill the directions the data cannot see")
-    p.add_argument("--prior-weight", type=float, metavar="W",
-                   help="with --prior: its weight (default 1e-5, docs/identification.md)")
+    p.add_argument(
+        "--friction", action="store_true", help="add viscous and Coulomb friction columns Fv, Fs"
+    )
+    p.add_argument(
+        "--offset", action="store_true", help="add a constant torque (sensor offset) per joint"
+    )
+    p.add_argument(
+        "--position-torque",
+        action="store_true",
+        help="add a torque ks_j sin q_j + kc_j cos q_j per joint (sensor/gear ripple "
+        "once per turn, cable or spring stiffness), on the joints where it is "
+        "distinguishable from gravity (docs/identification.md)",
+    )
+    p.add_argument(
+        "--method",
+        choices=("ols", "wls"),
+        default="wls",
+        help="ordinary or weighted (per-joint noise) least squares (default wls)",
+    )
+    p.add_argument(
+        "--physical",
+        action="store_true",
+        help="physically consistent fit (SDP: every link a possible rigid body, "
+        "Ia, Fv, Fs >= 0); the result holds a full robot (docs/identification.md)",
+    )
+    p.add_argument(
+        "--prior",
+        metavar="MODEL|URDF",
+        help="with --physical: the model (built-in name, model file or URDF) whose "
+        "parameters fill the directions the data cannot see",
+    )
+    p.add_argument(
+        "--prior-weight",
+        type=float,
+        metavar="W",
+        help="with --prior: its weight (default 1e-5, docs/identification.md)",
+    )
     _add_preparation(p)
-    p.add_argument("--min-velocity", type=float, metavar="V",
-                   help="drop samples where some joint has |qd| < V (friction near zero speed)")
-    p.add_argument("--outliers", type=float, metavar="K",
-                   help="drop torque spikes beyond K robust sigmas")
-    p.add_argument("--output", default="dynid-identify", metavar="DIR",
-                   help="output folder (default ./dynid-identify)")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace the output folder if it exists and is not empty")
+    p.add_argument(
+        "--min-velocity",
+        type=float,
+        metavar="V",
+        help="drop samples where some joint has |qd| < V (friction near zero speed)",
+    )
+    p.add_argument(
+        "--outliers", type=float, metavar="K", help="drop torque spikes beyond K robust sigmas"
+    )
+    p.add_argument(
+        "--output",
+        default="dynid-identify",
+        metavar="DIR",
+        help="output folder (default ./dynid-identify)",
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the output folder if it exists and is not empty",
+    )
     p.set_defaults(run=commands.identify)
 
 
 def _add_validate(subcommands: Any) -> None:
     p = subcommands.add_parser(
-        "validate", help="apply a saved identification to another log",
+        "validate",
+        help="apply a saved identification to another log",
         description="Predict the torques of LOG with a result of `dynid identify` and report "
         "per-joint RMS, relative RMS, maximum error and R^2; write validation.json and plots.",
     )
     p.add_argument("result", help="result folder of `dynid identify`, or its result.json")
     p.add_argument("log", help="measurement log, .npz or .csv")
     _add_preparation(p)
-    p.add_argument("--output", default="dynid-validate", metavar="DIR",
-                   help="output folder (default ./dynid-validate)")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace the output folder if it exists and is not empty")
+    p.add_argument(
+        "--output",
+        default="dynid-validate",
+        metavar="DIR",
+        help="output folder (default ./dynid-validate)",
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the output folder if it exists and is not empty",
+    )
     p.set_defaults(run=commands.validate)
 
 
 def _add_info(subcommands: Any) -> None:
     p = subcommands.add_parser(
-        "info", help="show a model: DH table, parameters, base-parameter counts",
+        "info",
+        help="show a model: DH table, parameters, base-parameter counts",
     )
     _add_model(p)
     p.set_defaults(run=commands.info)
@@ -101,7 +142,8 @@ def _add_info(subcommands: Any) -> None:
 
 def _add_export(subcommands: Any) -> None:
     p = subcommands.add_parser(
-        "export", help="write a model or a physically consistent result as URDF",
+        "export",
+        help="write a model or a physically consistent result as URDF",
         description="Write the robot of SOURCE as a URDF: SOURCE is a result folder (or its "
         "result.json) of `dynid identify --physical`, a built-in model name, a model file or a "
         "URDF. Least-squares results hold base parameters only and cannot be exported.",
@@ -115,45 +157,88 @@ def _add_export(subcommands: Any) -> None:
 
 def _add_residual(subcommands: Any) -> None:
     p = subcommands.add_parser(
-        "residual", help="collision residual (momentum observer) of a model along a log",
+        "residual",
+        help="collision residual (momentum observer) of a model along a log",
         description="Run the generalized-momentum observer (De Luca; docs/uses.md) of MODEL over "
         "LOG: r tracks the external joint torques, zero (to the model error) without contact. "
         "Writes residual.npz (t, r, gain, dt, rms, max_abs) and residual.png.",
     )
-    p.add_argument("model", metavar="MODEL",
-                   help="result folder/result.json of `dynid identify`, a built-in model, a "
-                   "model file or a URDF")
+    p.add_argument(
+        "model",
+        metavar="MODEL",
+        help="result folder/result.json of `dynid identify`, a built-in model, a "
+        "model file or a URDF",
+    )
     p.add_argument("log", help="measurement log, .npz or .csv")
-    p.add_argument("--gain", type=float, default=20.0,
-                   help="observer gain K_O [1/s], the inverse time constant (default 20)")
-    p.add_argument("--threshold", type=float, metavar="T",
-                   help="draw +-T [N m] in the plot (a collision threshold)")
+    p.add_argument(
+        "--gain",
+        type=float,
+        default=20.0,
+        help="observer gain K_O [1/s], the inverse time constant (default 20)",
+    )
+    p.add_argument(
+        "--threshold",
+        type=float,
+        metavar="T",
+        help="draw +-T [N m] in the plot (a collision threshold)",
+    )
     p.add_argument("--skip", type=int, default=0, metavar="N", help="drop the first N samples")
     p.add_argument("--columns", metavar="MAP", help="columns/keys of a foreign log (docs/data.md)")
-    p.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s",
-                   help="unit of the log's time stamps (default s)")
-    p.add_argument("--output", default="dynid-residual", metavar="DIR",
-                   help="output folder (default ./dynid-residual)")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace the output folder if it exists and is not empty")
+    p.add_argument(
+        "--time-unit",
+        choices=("s", "ms", "us", "ns"),
+        default="s",
+        help="unit of the log's time stamps (default s)",
+    )
+    p.add_argument(
+        "--output",
+        default="dynid-residual",
+        metavar="DIR",
+        help="output folder (default ./dynid-residual)",
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the output folder if it exists and is not empty",
+    )
     p.set_defaults(run=commands.residual)
 
 
 def _add_model(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--model", default=DEFAULT_MODEL, metavar="NAME|FILE",
-                   help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
-                   f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}")
+    p.add_argument(
+        "--model",
+        default=DEFAULT_MODEL,
+        metavar="NAME|FILE",
+        help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
+        f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}",
+    )
 
 
 def _add_preparation(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--skip", type=int, default=0, metavar="N",
-                   help="drop the first N samples (start-up transient)")
-    p.add_argument("--columns", metavar="MAP",
-                   help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
-                   "(glob patterns, joints in natural order; docs/data.md)")
-    p.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), default="s",
-                   help="unit of the log's time stamps (default s)")
-    p.add_argument("--cutoff", type=float, metavar="HZ",
-                   help="zero-phase Butterworth low-pass of q, qd, qdd, tau at HZ")
+    p.add_argument(
+        "--skip",
+        type=int,
+        default=0,
+        metavar="N",
+        help="drop the first N samples (start-up transient)",
+    )
+    p.add_argument(
+        "--columns",
+        metavar="MAP",
+        help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
+        "(glob patterns, joints in natural order; docs/data.md)",
+    )
+    p.add_argument(
+        "--time-unit",
+        choices=("s", "ms", "us", "ns"),
+        default="s",
+        help="unit of the log's time stamps (default s)",
+    )
+    p.add_argument(
+        "--cutoff",
+        type=float,
+        metavar="HZ",
+        help="zero-phase Butterworth low-pass of q, qd, qdd, tau at HZ",
+    )
     p.add_argument("--order", type=int, default=4, help="order of that filter (default 4)")
     p.add_argument("--decimate", type=int, default=1, metavar="K", help="keep every K-th sample")

@@ -346,9 +346,7 @@ def _check_initial(
 ) -> FourierTrajectory:
     if not isinstance(initial, FourierTrajectory):
         # SPEC section 2: a wrong type is a ValueError too
-        raise ValueError(
-            f"initial: expected a FourierTrajectory, got {type(initial).__name__}"
-        )
+        raise ValueError(f"initial: expected a FourierTrajectory, got {type(initial).__name__}")
     if (initial.n, initial.harmonics) != (n, harmonics) or not np.isclose(initial.period, period):
         raise ValueError(
             f"initial: expected {n} joints, harmonics={harmonics}, period={period}, got "

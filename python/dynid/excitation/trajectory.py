@@ -94,8 +94,10 @@ class FourierTrajectory:
             q, qd, qdd = Bq @ c.T + self.q0, Bqd @ c.T, Bqdd @ c.T
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):
             # Finite but huge coefficients or times overflow: an error, never a silent NaN.
-            raise ValueError("t: q, qd or qdd overflow at these times with this trajectory's "
-                             "coefficients (a, b, q0, base_frequency); use smaller values")
+            raise ValueError(
+                "t: q, qd or qdd overflow at these times with this trajectory's "
+                "coefficients (a, b, q0, base_frequency); use smaller values"
+            )
         if times.ndim == 0:
             return q[0], qd[0], qdd[0]
         return q, qd, qdd
@@ -314,4 +316,3 @@ def _qlim(value: ArrayLike, n: int) -> tuple[NDArray[np.float64], NDArray[np.flo
     if limits.shape != (n, 2) or np.any(limits[:, 0] >= limits[:, 1]):
         raise ValueError(f"qlim: expected ({n}, 2) rows [lower, upper] with lower < upper")
     return limits[:, 0], limits[:, 1]
-

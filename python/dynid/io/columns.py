@@ -43,8 +43,9 @@ def check_columns(columns: Mapping[str, str]) -> dict[str, str]:
         if signal not in MAPPABLE:
             raise ValueError(f"columns: unknown signal {signal!r}; expected one of {MAPPABLE}")
         if not isinstance(pattern, str) or not pattern:
-            raise ValueError(f"columns: the pattern for {signal!r} must be a non-empty string, "
-                             f"got {pattern!r}")
+            raise ValueError(
+                f"columns: the pattern for {signal!r} must be a non-empty string, got {pattern!r}"
+            )
         checked[signal] = pattern
     return checked
 
@@ -60,8 +61,9 @@ def matching(pattern: str, names: Sequence[str], signal: str) -> list[str]:
     """The names matching ``pattern`` in natural order; a ValueError naming the signal if none."""
     found = [name for name in names if fnmatch.fnmatchcase(name, pattern)]
     if not found:
-        raise ValueError(f"columns: nothing matches {pattern!r} for {signal}; found "
-                         f"{', '.join(names)}")
+        raise ValueError(
+            f"columns: nothing matches {pattern!r} for {signal}; found {', '.join(names)}"
+        )
     return sorted(found, key=_natural_key)
 
 

@@ -76,8 +76,11 @@ class Log(ValueEquality):
             if arr.ndim != 2:
                 raise ValueError(f"{name}: expected shape (T, n), got {arr.shape}")
             setattr(self, name, arr)
-        lengths = {name: len(getattr(self, name)) for name in ("t", *SIGNALS)
-                   if getattr(self, name) is not None}
+        lengths = {
+            name: len(getattr(self, name))
+            for name in ("t", *SIGNALS)
+            if getattr(self, name) is not None
+        }
         if len(set(lengths.values())) > 1:
             listed = ", ".join(f"{k} has {v}" for k, v in lengths.items())
             raise ValueError(f"length mismatch: every array needs one row per sample; {listed}")
@@ -85,9 +88,7 @@ class Log(ValueEquality):
         for name in SIGNALS[1:]:
             value = getattr(self, name)
             if value is not None and value.shape[1] != n:
-                raise ValueError(
-                    f"{name}: has {value.shape[1]} joints (columns) but q has {n}"
-                )
+                raise ValueError(f"{name}: has {value.shape[1]} joints (columns) but q has {n}")
         if n < 1:
             raise ValueError("q: has no joints (0 columns)")
         for name in ("t", *SIGNALS):
@@ -132,7 +133,9 @@ class Log(ValueEquality):
         """A new, checked Log with some arrays replaced and ``note`` appended to the notes."""
         unknown = set(arrays) - {"t", *SIGNALS}
         if unknown:
-            raise ValueError(f"arrays: unknown names {sorted(unknown)}; expected t, q, tau, qd, qdd")
+            raise ValueError(
+                f"arrays: unknown names {sorted(unknown)}; expected t, q, tau, qd, qdd"
+            )
         values = {name: getattr(self, name) for name in ("t", *SIGNALS)}
         values.update(arrays)
         notes = self.notes + ([note] if note else [])
@@ -146,12 +149,16 @@ class Log(ValueEquality):
         mask = np.asarray(mask)
         if mask.dtype == bool:
             if mask.shape != (self.T,):
-                raise ValueError(f"mask: expected a boolean array of shape ({self.T},), got {mask.shape}")
+                raise ValueError(
+                    f"mask: expected a boolean array of shape ({self.T},), got {mask.shape}"
+                )
             kept = int(mask.sum())
         elif np.issubdtype(mask.dtype, np.integer) and mask.ndim == 1:
             if mask.size and (mask.min() < 0 or mask.max() >= self.T):
-                raise ValueError(f"mask: sample indices must lie in [0, {self.T}), got "
-                                 f"{mask.min()}..{mask.max()}")
+                raise ValueError(
+                    f"mask: sample indices must lie in [0, {self.T}), got "
+                    f"{mask.min()}..{mask.max()}"
+                )
             kept = mask.size
         else:
             raise ValueError(
@@ -160,12 +167,16 @@ class Log(ValueEquality):
             )
         if note is None:
             note = f"selected {kept} of {self.T} samples"
-        arrays = {name: getattr(self, name)[mask] for name in ("t", *SIGNALS)
-                  if getattr(self, name) is not None}
+        arrays = {
+            name: getattr(self, name)[mask]
+            for name in ("t", *SIGNALS)
+            if getattr(self, name) is not None
+        }
         return self.replace(note=note, **arrays)
 
-    def slice(self, start: int | None = None, stop: int | None = None, *,
-              note: str | None = None) -> Log:
+    def slice(
+        self, start: int | None = None, stop: int | None = None, *, note: str | None = None
+    ) -> Log:
         """Samples start:stop (Python slice semantics, negative indices allowed)."""
         for name, value in (("start", start), ("stop", stop)):
             if value is not None and not is_integer(value):
@@ -229,7 +240,9 @@ def load_log(
         raise FileNotFoundError(f"path: no such file: {path}")
     suffix = path.suffix.lower()
     if suffix not in (".npz", ".csv"):
-        raise ValueError(f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv")
+        raise ValueError(
+            f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv"
+        )
     skip = count(skip, "skip", 0)
     mapping = check_columns(columns) if columns is not None else None
     seconds = time_scale(time_unit)
@@ -262,13 +275,16 @@ def warn_implausible(log: Log, what: str) -> None:
         warnings.warn(
             f"{what}: t: the median sampling rate is {fs:.3g} Hz, implausible for a robot log; "
             f"check the unit of the time stamps (time_unit / --time-unit, e.g. {guess!r})",
-            UserWarning, stacklevel=3,
+            UserWarning,
+            stacklevel=3,
         )
     largest = float(np.max(np.abs(log.q)))
     if largest > PLAUSIBLE_POSITION:
         warnings.warn(
             f"{what}: q: positions up to {largest:.4g}; dynid expects radians (or metres): "
-            "degrees or encoder counts?", UserWarning, stacklevel=3,
+            "degrees or encoder counts?",
+            UserWarning,
+            stacklevel=3,
         )
 
 
@@ -290,10 +306,14 @@ def _mapped_arrays(
         elif signal != "t" and all(part.ndim == 1 for part in parts):
             arrays[signal] = np.column_stack(parts)
         else:
-            expected = ("one time vector" if signal == "t"
-                        else "one (T, n) array or 1-D columns, one per joint")
-            raise ValueError(f"columns: {pattern!r} for {signal} matches {', '.join(found)}; "
-                             f"expected {expected}")
+            expected = (
+                "one time vector"
+                if signal == "t"
+                else "one (T, n) array or 1-D columns, one per joint"
+            )
+            raise ValueError(
+                f"columns: {pattern!r} for {signal} matches {', '.join(found)}; expected {expected}"
+            )
     return arrays
 
 
@@ -347,12 +367,16 @@ def _check_npz_members(path: Path) -> None:
             with archive.open(info) as member:
                 try:
                     version = np.lib.format.read_magic(member)
-                    read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
-                            else np.lib.format.read_array_header_2_0)
+                    read = (
+                        np.lib.format.read_array_header_1_0
+                        if version == (1, 0)
+                        else np.lib.format.read_array_header_2_0
+                    )
                     shape, _, dtype = read(member)
                 except (ValueError, OSError, EOFError) as exc:
-                    raise ValueError(f"member {info.filename!r}: unreadable header ({exc})"
-                                     ) from None
+                    raise ValueError(
+                        f"member {info.filename!r}: unreadable header ({exc})"
+                    ) from None
             needed = dtype.itemsize * int(np.prod(shape, dtype=object))
             if needed > info.file_size:
                 raise ValueError(
@@ -375,7 +399,7 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
         for number, line in enumerate(handle, start=1):
             text = line.strip()
             if text.startswith("# note:"):
-                notes.append(text[len("# note:"):].strip())
+                notes.append(text[len("# note:") :].strip())
             if not text or text.startswith("#"):
                 continue
             if header is None:
@@ -408,8 +432,7 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
                 values[r, c] = float(field_text)
             except ValueError:
                 raise ValueError(
-                    f"line {lines[r]}, column {header[c]!r}: cannot read {field_text!r} as a "
-                    "number"
+                    f"line {lines[r]}, column {header[c]!r}: cannot read {field_text!r} as a number"
                 ) from None
     return header, values, lines, notes
 
@@ -481,9 +504,7 @@ def save_log(log: Log, path: PathLike) -> None:
     ``# note:`` lines in CSV) and come back on loading.
     """
     if not isinstance(log, Log):
-        raise ValueError(
-            f"log: expected a dynid.io.Log, got {type(log).__name__}"
-        )
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
     path = Path(path)
     suffix = path.suffix.lower()
     present = [name for name in SIGNALS if getattr(log, name) is not None]
@@ -502,4 +523,3 @@ def save_log(log: Log, path: PathLike) -> None:
             np.savetxt(handle, table, delimiter=",", fmt="%.17g")
     else:
         raise ValueError(f"path: unknown extension {path.suffix!r}; expected .npz or .csv")
-

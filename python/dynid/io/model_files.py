@@ -43,13 +43,29 @@ BUILTIN_MODELS: dict[str, Callable[[], Robot]] = {
 FORMAT = "dynid-model"
 #: Fields a model file may hold besides the model itself (ignored).
 METADATA = ("format", "version", "description", "notes", "source", "units")
-FIELDS = ("name", "convention", "joint_types", "gravity", "rows", "base", "tool", "qlim",
-          "params", "Ia", "Fv", "Fs")
+FIELDS = (
+    "name",
+    "convention",
+    "joint_types",
+    "gravity",
+    "rows",
+    "base",
+    "tool",
+    "qlim",
+    "params",
+    "Ia",
+    "Fv",
+    "Fs",
+)
 #: Row fields: the standard name, then the names accepted for it.
 ROW_NAMES = {
     "standard": {"a": ("a",), "alpha": ("alpha",), "d": ("d",), "theta": ("theta", "theta_offset")},
-    "modified": {"a": ("a", "a_prev"), "alpha": ("alpha", "alpha_prev"), "d": ("d",),
-                 "theta": ("theta", "theta_offset")},
+    "modified": {
+        "a": ("a", "a_prev"),
+        "alpha": ("alpha", "alpha_prev"),
+        "d": ("d",),
+        "theta": ("theta", "theta_offset"),
+    },
 }
 YAML_SUFFIXES = (".yaml", ".yml")
 
@@ -114,9 +130,7 @@ def save_model(robot: Robot, path: PathLike) -> Path:
 def model_from_dict(data: Any) -> Robot:
     """A Robot from the parsed content of a model file (see the module docstring)."""
     if not isinstance(data, Mapping):
-        raise ValueError(
-            f"expected an object with the model's fields, got {type(data).__name__}"
-        )
+        raise ValueError(f"expected an object with the model's fields, got {type(data).__name__}")
     unknown = [str(k) for k in data if k not in FIELDS and k not in METADATA]
     if unknown:
         hint = ""
@@ -136,8 +150,9 @@ def model_from_dict(data: Any) -> Robot:
     if not isinstance(rows, list) or not rows:
         raise ValueError(f"rows: expected a non-empty list of DH rows, got {rows!r:.60}")
     if len(rows) > MAX_JOINTS:
-        raise ValueError(f"rows: {len(rows)} DH rows; dynid model files hold at most "
-                         f"{MAX_JOINTS} joints")
+        raise ValueError(
+            f"rows: {len(rows)} DH rows; dynid model files hold at most {MAX_JOINTS} joints"
+        )
     dh = np.array([_row(row, i, convention) for i, row in enumerate(rows)])
     n = len(dh)
     name = data.get("name")
@@ -145,20 +160,31 @@ def model_from_dict(data: Any) -> Robot:
         raise ValueError(f"name: expected a string, got {name!r}")
     joint_types = data.get("joint_types", "R" * n)
     if not isinstance(joint_types, str):
-        raise ValueError(
-            f"joint_types: expected a string of R/P letters, got {joint_types!r}"
-        )
+        raise ValueError(f"joint_types: expected a string of R/P letters, got {joint_types!r}")
     arrays = {
         key: _numbers(data[key], key, shape)
-        for key, shape in (("gravity", (3,)), ("base", (4, 4)), ("tool", (4, 4)),
-                           ("qlim", (n, 2)), ("params", (n, 10)), ("Ia", (n,)), ("Fv", (n,)),
-                           ("Fs", (n,)))
+        for key, shape in (
+            ("gravity", (3,)),
+            ("base", (4, 4)),
+            ("tool", (4, 4)),
+            ("qlim", (n, 2)),
+            ("params", (n, 10)),
+            ("Ia", (n,)),
+            ("Fv", (n,)),
+            ("Fs", (n,)),
+        )
         if data.get(key) is not None
     }
     robot = Robot.from_dh(
-        dh, joint_types, convention, arrays.get("gravity", (0.0, 0.0, -9.81)),
-        params=arrays.get("params"), base=arrays.get("base"), tool=arrays.get("tool"),
-        qlim=arrays.get("qlim"), name=name,
+        dh,
+        joint_types,
+        convention,
+        arrays.get("gravity", (0.0, 0.0, -9.81)),
+        params=arrays.get("params"),
+        base=arrays.get("base"),
+        tool=arrays.get("tool"),
+        qlim=arrays.get("qlim"),
+        name=name,
     )
     for key in ("Ia", "Fv", "Fs"):
         if key in arrays:
@@ -239,8 +265,9 @@ def _numbers(value: Any, where: str, shape: tuple[int, ...]) -> np.ndarray:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
         array = None
-    if array is None or not (array.shape == shape or (shape[-1:] == (10,) and array.shape
-                                                      == (shape[0] * 10,))):
+    if array is None or not (
+        array.shape == shape or (shape[-1:] == (10,) and array.shape == (shape[0] * 10,))
+    ):
         got = f"shape {array.shape}" if array is not None else f"{value!r:.60}"
         raise ValueError(f"{where}: expected numbers of shape {shape}, got {got}")
     if not np.all(np.isfinite(array)):
@@ -268,8 +295,10 @@ def read_structured(path: Path) -> Any:
         raise ValueError(f"unknown extension {path.suffix!r}; expected .json, .yaml or .yml")
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
-        raise ValueError(f"{size} bytes is more than a model or result file can need "
-                         f"(limit {MAX_FILE_BYTES} bytes)")
+        raise ValueError(
+            f"{size} bytes is more than a model or result file can need "
+            f"(limit {MAX_FILE_BYTES} bytes)"
+        )
     try:
         text = path.read_text()
     except UnicodeDecodeError:
@@ -279,8 +308,9 @@ def read_structured(path: Path) -> Any:
             return _load_yaml(text, path)
         return json.loads(text)
     except json.JSONDecodeError as exc:
-        raise ValueError(f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}"
-                         ) from None
+        raise ValueError(
+            f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}"
+        ) from None
     except RecursionError:
         raise ValueError("nesting too deep to be a model or result file") from None
 
@@ -317,8 +347,10 @@ def _check_expanded_size(data: Any) -> None:
     def visit(value: Any) -> None:
         budget[0] -= 1
         if budget[0] < 0:
-            raise ValueError(f"the YAML file expands to more than {MAX_EXPANDED_VALUES} values "
-                             "(nested aliases): refused")
+            raise ValueError(
+                f"the YAML file expands to more than {MAX_EXPANDED_VALUES} values "
+                "(nested aliases): refused"
+            )
         children = value.values() if isinstance(value, dict) else value
         if isinstance(value, (dict, list)):
             for child in children:
@@ -343,8 +375,9 @@ def dumps_json(value: Any, indent: int = 0) -> str:
     objects) on one line each: readable DH tables and parameter matrices, exact floats."""
     pad, inner = " " * indent, " " * (indent + 2)
     if isinstance(value, Mapping) and value and not _flat(value):
-        items = [f"{inner}{json.dumps(str(k))}: {dumps_json(v, indent + 2)}"
-                 for k, v in value.items()]
+        items = [
+            f"{inner}{json.dumps(str(k))}: {dumps_json(v, indent + 2)}" for k, v in value.items()
+        ]
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
     if isinstance(value, list) and value and not _flat(value):
         items = [inner + dumps_json(v, indent + 2) for v in value]
@@ -356,4 +389,6 @@ def _flat(value: Any) -> bool:
     """Lists of scalars, and objects of at most 6 scalars (a DH row), go on one line."""
     scalars = (str, int, float, bool, type(None))
     items = list(value.values()) if isinstance(value, Mapping) else value
-    return all(isinstance(v, scalars) for v in items) and (isinstance(value, list) or len(items) <= 6)
+    return all(isinstance(v, scalars) for v in items) and (
+        isinstance(value, list) or len(items) <= 6
+    )

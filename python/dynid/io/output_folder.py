@@ -40,12 +40,16 @@ def check_output_path(folder: PathLike, overwrite: bool, name: str = "output") -
 
 
 @contextmanager
-def output_folder(folder: PathLike, overwrite: bool = False, name: str = "output") -> Iterator[Path]:
+def output_folder(
+    folder: PathLike, overwrite: bool = False, name: str = "output"
+) -> Iterator[Path]:
     """Yield a temporary folder to write into; on leaving the block without an error it becomes
     ``folder`` (see the module docstring); on an error it is removed and ``folder`` is untouched."""
     target = check_output_path(folder, overwrite, name)
     target.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
+    staging = Path(
+        tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent)
+    )
     try:
         yield staging
     except BaseException:

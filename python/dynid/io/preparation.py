@@ -68,9 +68,7 @@ def prepare_log(
     Sample removals come last because filters, derivatives and decimation need the uniform grid.
     """
     if not isinstance(log, Log):
-        raise ValueError(
-            f"log: expected a dynid.io.Log, got {type(log).__name__}"
-        )
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
     if differentiate not in ("missing", "always", "never"):
         raise ValueError(
             f"differentiate: expected 'missing', 'always' or 'never', got {differentiate!r}"
@@ -173,8 +171,9 @@ def prepare_log(
                     f"reference_tau(log): expected shape {log.tau.shape}, got {predicted.shape}"
                 )
         spread = sig.MAD_TO_SIGMA * np.median(np.abs(log.tau - np.median(log.tau, axis=0)), axis=0)
-        outliers = sig.outlier_mask(log.tau - predicted, outlier_k,
-                                    min_sigma=sig.SPIKE_FLOOR * spread)
+        outliers = sig.outlier_mask(
+            log.tau - predicted, outlier_k, min_sigma=sig.SPIKE_FLOOR * spread
+        )
         flags = np.any(outliers, axis=1)
         why = (
             f"whose torque deviates from {what} by more than {outlier_k:g} robust sigmas "
@@ -196,7 +195,9 @@ def prepare_log(
         reasons = "; ".join(f"{int(rows.sum())} samples {why}" for rows, why in removals)
         if log.T - int(dropped.sum()) < 2:
             raise ValueError(f"prepare_log: fewer than 2 samples would remain; {reasons}")
-        log = log.select(~dropped, note=f"dropped {int(dropped.sum())} of {log.T} samples: {reasons}")
+        log = log.select(
+            ~dropped, note=f"dropped {int(dropped.sum())} of {log.T} samples: {reasons}"
+        )
     return log
 
 
@@ -212,8 +213,11 @@ def decimate_log(log: Log, factor: int, *, order: int = 8, antialias: bool = Tru
     if antialias:
         log.check_uniform("decimate")
     new = {
-        name: (sig.decimate(getattr(log, name), factor, order=order, antialias=antialias)
-               if getattr(log, name) is not None else None)
+        name: (
+            sig.decimate(getattr(log, name), factor, order=order, antialias=antialias)
+            if getattr(log, name) is not None
+            else None
+        )
         for name in SIGNALS
     }
     names = ", ".join(k for k, v in new.items() if v is not None)

@@ -32,8 +32,14 @@ FORMAT = "dynid-identification"
 #: Format version written; the loader reads versions 1 (no covariance) to VERSION.
 VERSION = 2
 #: Units of what a result holds (written into result.json for readers other than dynid).
-UNITS = {"length": "m", "angle": "rad", "mass": "kg", "time": "s", "torque": "N m",
-         "coefficients": "SI, as their expressions over the standard parameters"}
+UNITS = {
+    "length": "m",
+    "angle": "rad",
+    "mass": "kg",
+    "time": "s",
+    "torque": "N m",
+    "coefficients": "SI, as their expressions over the standard parameters",
+}
 RESULT_FILE = "result.json"
 VALIDATION_FORMAT = "dynid-validation"
 VALIDATION_FILE = "validation.json"
@@ -94,10 +100,19 @@ def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str
     t = log.t - log.t[0]
     name = Path(log.source).name or what
     return [
-        plot_torques(t, log.tau, predicted, folder / "torques.png",
-                     title=f"Measured and predicted joint torques ({what}: {name})"),
-        plot_residuals(t, predicted - log.tau, folder / "residuals.png",
-                       title=f"Torque residuals, predicted - measured ({what}: {name})"),
+        plot_torques(
+            t,
+            log.tau,
+            predicted,
+            folder / "torques.png",
+            title=f"Measured and predicted joint torques ({what}: {name})",
+        ),
+        plot_residuals(
+            t,
+            predicted - log.tau,
+            folder / "residuals.png",
+            title=f"Torque residuals, predicted - measured ({what}: {name})",
+        ),
     ]
 
 
@@ -124,10 +139,16 @@ def load_result(path: PathLike) -> LogIdentification:
 def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     """The content of ``result.json`` (JSON-ready)."""
     coefficients = [
-        {"name": name, "value": _num(value), "std": _num(std), "relative_std_percent": _num(rel),
-         "expression": expr}
-        for name, value, std, rel, expr in zip(result.names, result.theta, result.std,
-                                               result.relative_std, result.expressions)
+        {
+            "name": name,
+            "value": _num(value),
+            "std": _num(std),
+            "relative_std_percent": _num(rel),
+            "expression": expr,
+        }
+        for name, value, std, rel, expr in zip(
+            result.names, result.theta, result.std, result.relative_std, result.expressions
+        )
     ]
     training = dict(result.training)
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
@@ -137,9 +158,14 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         "dynid_version": dynid_version(),
         "units": UNITS,
         "model": result.model,
-        "options": {"rotor": result.rotor, "friction": result.friction, "offset": result.offset,
-                    "method": result.method, "exclude_joints": list(result.excluded),
-                    "position_torque_joints": [j + 1 for j in result.position_joints]},
+        "options": {
+            "rotor": result.rotor,
+            "friction": result.friction,
+            "offset": result.offset,
+            "method": result.method,
+            "exclude_joints": list(result.excluded),
+            "position_torque_joints": [j + 1 for j in result.position_joints],
+        },
         "condition_number": _num(result.condition_number),
         "rank": result.rank,
         "coefficients": coefficients,
@@ -161,13 +187,16 @@ def result_from_dict(data: Any) -> LogIdentification:
     """A LogIdentification from the content of ``result.json``."""
     data = _object(data, "result")
     if data.get("format") != FORMAT:
-        raise ValueError(f"format: expected {FORMAT!r} (a dynid identify result), got "
-                         f"{data.get('format')!r}")
+        raise ValueError(
+            f"format: expected {FORMAT!r} (a dynid identify result), got {data.get('format')!r}"
+        )
     version = data.get("version")
     if not (isinstance(version, int) and not isinstance(version, bool) and 1 <= version <= VERSION):
-        raise ValueError(f"version: expected a format version 1..{VERSION} (written by dynid "
-                         f"{data.get('dynid_version', '?')}; this is dynid {dynid_version()}), "
-                         f"got {version!r}")
+        raise ValueError(
+            f"version: expected a format version 1..{VERSION} (written by dynid "
+            f"{data.get('dynid_version', '?')}; this is dynid {dynid_version()}), "
+            f"got {version!r}"
+        )
     model = _object(_get(data, "model"), "model")
     try:
         robot = model_from_dict(model)
@@ -177,9 +206,7 @@ def result_from_dict(data: Any) -> LogIdentification:
     flags = {k: _get(options, k, "options") for k in ("rotor", "friction", "offset")}
     for key, value in flags.items():
         if not isinstance(value, bool):
-            raise ValueError(
-                f"options.{key}: expected true or false, got {value!r}"
-            )
+            raise ValueError(f"options.{key}: expected true or false, got {value!r}")
     base = _object(_get(data, "base_parameters"), "base_parameters")
     names_std = _get(base, "parameter_names", "base_parameters")
     expected = robot.parameter_names(flags["rotor"], flags["friction"])
@@ -188,15 +215,17 @@ def result_from_dict(data: Any) -> LogIdentification:
             f"base_parameters.parameter_names: do not match the model's regressor columns "
             f"({len(expected)} expected for rotor={flags['rotor']}, friction={flags['friction']})"
         )
-    independent = _array(_get(base, "independent", "base_parameters"),
-                         "base_parameters.independent", 1).astype(np.int64)
+    independent = _array(
+        _get(base, "independent", "base_parameters"), "base_parameters.independent", 1
+    ).astype(np.int64)
     count = independent.size
     if np.any(independent < 0) or np.any(independent >= len(expected)):
         raise ValueError("base_parameters.independent: column index out of range")
     beta = _array(_get(base, "beta", "base_parameters"), "base_parameters.beta", 2)
     if beta.shape != (count, len(expected)):
-        raise ValueError(f"base_parameters.beta: expected shape {(count, len(expected))}, "
-                         f"got {beta.shape}")
+        raise ValueError(
+            f"base_parameters.beta: expected shape {(count, len(expected))}, got {beta.shape}"
+        )
     position_joints = _position_joints(options.get("position_torque_joints", []), robot.n)
     p = count + (robot.n if flags["offset"] else 0) + 2 * len(position_joints)
     rows = _get(data, "coefficients")
@@ -209,31 +238,43 @@ def result_from_dict(data: Any) -> LogIdentification:
     }
     training = _object(data.get("training", {}), "training")
     metrics = _object(training.get("metrics", {}), "training.metrics")
-    training["metrics"] = {k: _array(v, f"training.metrics.{k}", 1, nullable=True)
-                           for k, v in metrics.items()}
+    training["metrics"] = {
+        k: _array(v, f"training.metrics.{k}", 1, nullable=True) for k, v in metrics.items()
+    }
     method = _get(options, "method", "options")
     physical = data.get("physical")
     if physical is not None:
         physical = _object(physical, "physical")
         if not robot.is_physically_consistent():
-            raise ValueError("model: a physically consistent result whose parameters are not "
-                             "physically consistent (edited file?)")
+            raise ValueError(
+                "model: a physically consistent result whose parameters are not "
+                "physically consistent (edited file?)"
+            )
     return LogIdentification(
-        model=dict(model), rotor=flags["rotor"], friction=flags["friction"],
-        offset=flags["offset"], method=str(method), parameter_names=list(names_std),
-        independent=independent, beta=beta, names=[str(x) for x in column["name"]],
+        model=dict(model),
+        rotor=flags["rotor"],
+        friction=flags["friction"],
+        offset=flags["offset"],
+        method=str(method),
+        parameter_names=list(names_std),
+        independent=independent,
+        beta=beta,
+        names=[str(x) for x in column["name"]],
         expressions=[str(x) for x in column["expression"]],
         theta=_array(column["value"], "coefficients[].value", 1),
         std=_array(column["std"], "coefficients[].std", 1, nullable=True),
-        relative_std=_array(column["relative_std_percent"],
-                            "coefficients[].relative_std_percent", 1, nullable=True),
-        condition_number=float(_array(_get(data, "condition_number"), "condition_number", 0,
-                                      nullable=True)),
+        relative_std=_array(
+            column["relative_std_percent"], "coefficients[].relative_std_percent", 1, nullable=True
+        ),
+        condition_number=float(
+            _array(_get(data, "condition_number"), "condition_number", 0, nullable=True)
+        ),
         rank=int(_array(_get(data, "rank"), "rank", 0)),
         excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
         training=training,
         covariance=_covariance(data.get("covariance"), p),
-        physical=physical, position_joints=position_joints,
+        physical=physical,
+        position_joints=position_joints,
         _robot=robot,
     )
 
@@ -241,11 +282,16 @@ def result_from_dict(data: Any) -> LogIdentification:
 def _position_joints(value: Any, n: int) -> tuple[int, ...]:
     """options.position_torque_joints (1-based, increasing; absent in older files: none) as
     0-based joints."""
-    if not (isinstance(value, list) and all(isinstance(j, int) and not isinstance(j, bool)
-                                            for j in value)
-            and all(1 <= j <= n for j in value) and value == sorted(set(value))):
-        raise ValueError(f"options.position_torque_joints: expected increasing joint numbers "
-                         f"1..{n}, got {value!r}")
+    if not (
+        isinstance(value, list)
+        and all(isinstance(j, int) and not isinstance(j, bool) for j in value)
+        and all(1 <= j <= n for j in value)
+        and value == sorted(set(value))
+    ):
+        raise ValueError(
+            f"options.position_torque_joints: expected increasing joint numbers "
+            f"1..{n}, got {value!r}"
+        )
     return tuple(j - 1 for j in value)
 
 
@@ -280,9 +326,7 @@ def _nums(value: Any) -> Any:
 
 def _object(value: Any, where: str) -> dict[str, Any]:
     if not isinstance(value, dict):
-        raise ValueError(
-            f"{where}: expected an object, got {type(value).__name__}"
-        )
+        raise ValueError(f"{where}: expected an object, got {type(value).__name__}")
     return dict(value)
 
 

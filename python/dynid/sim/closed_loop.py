@@ -94,9 +94,7 @@ def simulate(
         Seed of the torque noise.
     """
     if not isinstance(robot, _core.Model):
-        raise ValueError(
-            f"robot: expected a dynid.Robot, got {type(robot).__name__}"
-        )
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     n = robot.n
     q0 = _vector(q0, "q0", n)
     qd0 = np.zeros(n) if qd0 is None else _vector(qd0, "qd0", n)
@@ -104,8 +102,10 @@ def simulate(
     duration = _number(duration, "duration", positive=True)
     periods = round(duration / dt)
     if periods > 2**31 - 2:
-        raise ValueError(f"duration: at most 2^31 - 2 control periods, got {periods} "
-                         f"({duration:g} s at dt = {dt:g} s)")
+        raise ValueError(
+            f"duration: at most 2^31 - 2 control periods, got {periods} "
+            f"({duration:g} s at dt = {dt:g} s)"
+        )
     if periods < 1 or abs(periods * dt - duration) > 1e-9 * max(duration, dt):
         raise ValueError(
             f"duration: expected a positive whole number of control periods dt = {dt:g} s, "
@@ -118,16 +118,29 @@ def simulate(
         raise ValueError(f"friction: expected True or False, got {friction!r}")
     coulomb_band = _number(coulomb_band, "coulomb_band", positive=False)
     torque_noise = _number(torque_noise, "torque_noise", positive=False)
-    counts = (0.0 if encoder_counts is None
-              else _number(encoder_counts, "encoder_counts", positive=True))
+    counts = (
+        0.0 if encoder_counts is None else _number(encoder_counts, "encoder_counts", positive=True)
+    )
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
 
     t = (np.arange(periods + 1) * dt).astype(np.float64)
     law = _controller_arguments(controller, robot, t, n)
     q, qd, qdd, tau, q_measured = _core._simulate(
-        robot, q0, qd0, periods, dt, substeps, method, bool(friction), coulomb_band,
-        torque_noise, counts, int(seed), record_measured=True, **law,
+        robot,
+        q0,
+        qd0,
+        periods,
+        dt,
+        substeps,
+        method,
+        bool(friction),
+        coulomb_band,
+        torque_noise,
+        counts,
+        int(seed),
+        record_measured=True,
+        **law,
     )
     assert q_measured is not None  # asked for with record_measured=True
     return Simulation(t=t, q=q, qd=qd, qdd=qdd, tau=tau, q_measured=q_measured)
@@ -148,8 +161,15 @@ def _controller_arguments(
     controller: Controller | None, robot: Robot, t: NDArray, n: int
 ) -> dict[str, Any]:
     """The keyword arguments of _core._simulate that describe the control law."""
-    law: dict[str, Any] = {"model": None, "kp": None, "kd": None, "q_d": None, "qd_d": None,
-                           "qdd_d": None, "function": None}
+    law: dict[str, Any] = {
+        "model": None,
+        "kp": None,
+        "kd": None,
+        "q_d": None,
+        "qd_d": None,
+        "qdd_d": None,
+        "function": None,
+    }
     if controller is None:  # zero torque: a PD law with zero gains
         zeros = np.zeros(n)
         return {**law, "kind": "pd", "kp": zeros, "kd": zeros, "q_d": np.zeros((len(t), n))}
@@ -162,8 +182,15 @@ def _controller_arguments(
                 )
             law["model"] = controller.model
         q_d, qd_d, qdd_d = sample_reference(controller.reference, t, n)
-        return {**law, "kind": controller.kind, "kp": gains(controller.kp, "kp", n),
-                "kd": gains(controller.kd, "kd", n), "q_d": q_d, "qd_d": qd_d, "qdd_d": qdd_d}
+        return {
+            **law,
+            "kind": controller.kind,
+            "kp": gains(controller.kp, "kp", n),
+            "kd": gains(controller.kd, "kd", n),
+            "q_d": q_d,
+            "qd_d": qd_d,
+            "qdd_d": qdd_d,
+        }
     if callable(controller):
         return {**law, "kind": "callable", "function": controller}
     raise ValueError(

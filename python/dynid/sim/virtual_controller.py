@@ -192,9 +192,14 @@ class VirtualController:
         if substeps is None:
             substeps = stable_substeps(self.plant, q_d[0], 1.0 / rate, COULOMB_BAND, kd)
         run = simulate(
-            self.plant, q_d[0], qd_d[0], periods / rate,
+            self.plant,
+            q_d[0],
+            qd_d[0],
+            periods / rate,
             PDGravity(self.robot, kp, kd, (q_d, qd_d, qdd_d)),
-            dt=1.0 / rate, substeps=substeps, coulomb_band=COULOMB_BAND,
+            dt=1.0 / rate,
+            substeps=substeps,
+            coulomb_band=COULOMB_BAND,
             encoder_counts=self.encoder_counts,
         )
         # The sensor between gear and link: link equation (7) plus the link-side friction.
@@ -202,8 +207,9 @@ class VirtualController:
         tau += self.link_friction * plant_friction(self.plant, run.qd, COULOMB_BAND)
         if self.torque_noise > 0.0:
             tau = tau + self.torque_noise * self.rng.standard_normal(tau.shape)
-        return TorqueRecording(t=t, q=self._measure_position(run.q_measured), tau=tau,
-                               q_desired=q_d, motion=run)
+        return TorqueRecording(
+            t=t, q=self._measure_position(run.q_measured), tau=tau, q_desired=q_d, motion=run
+        )
 
     def _model_error(self, values: NDArray[np.float64]) -> NDArray[np.float64]:
         if self.model_noise == 0.0:
@@ -226,8 +232,9 @@ def _positive_number(value: object) -> bool:
     return bool(np.isfinite(number) and number > 0.0)
 
 
-def stable_substeps(robot: Robot, q: ArrayLike, dt: float, coulomb_band: float,
-                    kd: ArrayLike = 0.0) -> int:
+def stable_substeps(
+    robot: Robot, q: ArrayLike, dt: float, coulomb_band: float, kd: ArrayLike = 0.0
+) -> int:
     """Integration steps per control period dt that keep explicit RK4 stable near qd = 0.
 
     There the friction and the controller's damping act as a viscous term D = diag(Fv + Fs /

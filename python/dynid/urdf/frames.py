@@ -52,19 +52,27 @@ NEARLY_PARALLEL = (1e-10, 1e-3)
 def dh_standard(a: float, alpha: float, d: float, theta: float) -> Array:
     """A = Rz(theta) Tz(d) Tx(a) Rx(alpha) (SPEC 2)."""
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct],
-                     [st, ct * ca, -ct * sa, a * st],
-                     [0.0, sa, ca, d],
-                     [0.0, 0.0, 0.0, 1.0]])
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
 
 
 def dh_modified(a: float, alpha: float, d: float, theta: float) -> Array:
     """A = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i) (SPEC 2)."""
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st, 0.0, a],
-                     [st * ca, ct * ca, -sa, -d * sa],
-                     [st * sa, ct * sa, ca, d * ca],
-                     [0.0, 0.0, 0.0, 1.0]])
+    return np.array(
+        [
+            [ct, -st, 0.0, a],
+            [st * ca, ct * ca, -sa, -d * sa],
+            [st * sa, ct * sa, ca, d * ca],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
 
 
 def dh_frames(points: Array, axes: Array, tip: Array, convention: str) -> tuple[Array, Array]:
@@ -100,8 +108,9 @@ def _standard_rows(
     for i in range(n):
         origin, x_prev, z_prev = frame[:3, 3], frame[:3, 0], frame[:3, 2]
         if i + 1 < n:
-            foot, new_origin, x = _common_normal(origin, z_prev, points[i + 1], axes[i + 1],
-                                                 origin, x_prev)
+            foot, new_origin, x = _common_normal(
+                origin, z_prev, points[i + 1], axes[i + 1], origin, x_prev
+            )
             z = axes[i + 1]
         else:
             foot = new_origin = _foot(tip[:3, 3], origin, z_prev)
@@ -126,8 +135,9 @@ def _modified_rows(
         middle = frame @ dh_modified(a, alpha, 0.0, 0.0)
         point, x_prev, z = middle[:3, 3], middle[:3, 0], middle[:3, 2]
         if i + 1 < n:
-            origin, next_point, x = _common_normal(point, z, points[i + 1], axes[i + 1],
-                                                   point, x_prev)
+            origin, next_point, x = _common_normal(
+                point, z, points[i + 1], axes[i + 1], point, x_prev
+            )
         else:
             origin = _foot(tip[:3, 3], point, z)
             x = _perpendicular(tip[:3, :3], z)
@@ -140,8 +150,9 @@ def _modified_rows(
             alpha = _angle(frame[:3, 2], axes[i + 1], frame[:3, 0])
 
 
-def _common_normal(p: Array, u: Array, q: Array, v: Array, reference: Array, x_prev: Array
-                   ) -> tuple[Array, Array, Array]:
+def _common_normal(
+    p: Array, u: Array, q: Array, v: Array, reference: Array, x_prev: Array
+) -> tuple[Array, Array, Array]:
     """Feet of the common normal on line (p, u) and line (q, v), and its unit direction x.
     ``reference`` (a point on the first line) places the normal between parallel lines."""
     c = np.cross(u, v)

@@ -45,8 +45,12 @@ class DHModel:
     link_names: list[str]  # child link of each joint
 
 
-def dh_model_from_urdf(urdf: str | Path, base_link: str | None = None, tip_link: str | None = None,
-                       convention: str = "standard") -> DHModel:
+def dh_model_from_urdf(
+    urdf: str | Path,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    convention: str = "standard",
+) -> DHModel:
     """Read ``urdf`` (a path or the XML text) into a DH model (see
     :meth:`dynid.Robot.from_urdf`)."""
     if convention not in ("standard", "modified"):
@@ -63,33 +67,45 @@ def dh_model_from_urdf(urdf: str | Path, base_link: str | None = None, tip_link:
     dh, base_pose = dh_frames(points, axes, tip, convention)
     frames = _dh_frames_at_zero(dh, base_pose, convention)
     return DHModel(
-        name=tree.name, dh=dh, joint_types="".join("P" if j.type == "prismatic" else "R"
-                                                  for j in joints),
-        convention=convention, base=base_pose, tool=np.linalg.inv(frames[-1]) @ tip,
+        name=tree.name,
+        dh=dh,
+        joint_types="".join("P" if j.type == "prismatic" else "R" for j in joints),
+        convention=convention,
+        base=base_pose,
+        tool=np.linalg.inv(frames[-1]) @ tip,
         params=_link_parameters(tree, joints, poses, frames[1:]),
         qlim=np.array([_limits(j) for j in joints]),
-        Ia=np.array([j.rotor_inertia for j in joints]), Fv=np.array([j.damping for j in joints]),
-        Fs=np.array([j.friction for j in joints]), joint_names=[j.name for j in joints],
+        Ia=np.array([j.rotor_inertia for j in joints]),
+        Fv=np.array([j.damping for j in joints]),
+        Fs=np.array([j.friction for j in joints]),
+        joint_names=[j.name for j in joints],
         link_names=[j.child for j in joints],
     )
 
 
-def _link_parameters(tree: UrdfTree, joints: list[Joint], poses: dict[str, Array],
-                     frames: list[Array]) -> Array:
+def _link_parameters(
+    tree: UrdfTree, joints: list[Joint], poses: dict[str, Array], frames: list[Array]
+) -> Array:
     """(n, 10): the inertials of body i (see the module docstring) in DH frame i, summed."""
     bodies = _bodies(tree, joints)
     params = np.zeros((len(joints), 10))
     for i, joint in enumerate(joints):
-        inertials = [(link, tree.links[link]) for link, body in bodies.items()
-                     if body == i and tree.links[link] is not None]
+        inertials = [
+            (link, tree.links[link])
+            for link, body in bodies.items()
+            if body == i and tree.links[link] is not None
+        ]
         if not inertials:
-            raise ValueError(f"link {joint.child!r} (moved by joint {joint.name!r}) has no "
-                             "<inertial>, nor has any link fixed to it")
+            raise ValueError(
+                f"link {joint.child!r} (moved by joint {joint.name!r}) has no "
+                "<inertial>, nor has any link fixed to it"
+            )
         to_frame = np.linalg.inv(frames[i])
         for link, inertial in inertials:
             assert inertial is not None  # links without <inertial> were left out above
-            params[i] += standard_parameters(inertial.mass, to_frame @ poses[link] @ inertial.origin,
-                                             inertial.inertia)
+            params[i] += standard_parameters(
+                inertial.mass, to_frame @ poses[link] @ inertial.origin, inertial.inertia
+            )
     return params
 
 
@@ -103,7 +119,9 @@ def _warn_nearly_parallel(joints: list[Joint], axes: Array) -> None:
             f"joints {joints[i].name!r} and {joints[i + 1].name!r}: axes {angle:.1e} rad from "
             f"parallel, {'treated as parallel' if snapped else 'common normal far away'}; a DH "
             f"table cannot represent them exactly: expect errors of ~{error:.0e} relative "
-            "(docs/urdf.md)", stacklevel=4)  # the caller of Robot.from_urdf
+            "(docs/urdf.md)",
+            stacklevel=4,
+        )  # the caller of Robot.from_urdf
 
 
 def standard_parameters(mass: float, pose: Array, inertia: Array) -> Array:

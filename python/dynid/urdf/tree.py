@@ -68,8 +68,14 @@ class UrdfTree:
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> Array:
     """URDF ``rpy``: fixed-axis rotations about x, then y, then z, i.e.
     R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
-                              np.cos(yaw), np.sin(yaw))
+    cr, sr, cp, sp, cy, sy = (
+        np.cos(roll),
+        np.sin(roll),
+        np.cos(pitch),
+        np.sin(pitch),
+        np.cos(yaw),
+        np.sin(yaw),
+    )
     return np.array([
         [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
         [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
@@ -103,15 +109,19 @@ def read_tree(urdf: str | Path) -> UrdfTree:
         if joint.name in names:
             raise ValueError(f"urdf: two joints named {joint.name!r}")
         if joint.child in joints:
-            raise ValueError(f"urdf: link {joint.child!r} is the child of two joints "
-                             f"({joints[joint.child].name!r}, {joint.name!r}): not a tree")
+            raise ValueError(
+                f"urdf: link {joint.child!r} is the child of two joints "
+                f"({joints[joint.child].name!r}, {joint.name!r}): not a tree"
+            )
         names.add(joint.name)
         joints[joint.child] = joint
     tree = UrdfTree(root.get("name", "robot"), links, joints, names)
     roots = [name for name in links if name not in joints]
     if len(roots) != 1:
-        raise ValueError(f"urdf: expected one root link (a link that is no joint's child), got "
-                         f"{len(roots)}: {roots[:5]} (a cycle or several trees)")
+        raise ValueError(
+            f"urdf: expected one root link (a link that is no joint's child), got "
+            f"{len(roots)}: {roots[:5]} (a cycle or several trees)"
+        )
     reached, stack = {roots[0]}, [roots[0]]
     while stack:
         for joint in tree.children(stack.pop()):
@@ -119,8 +129,9 @@ def read_tree(urdf: str | Path) -> UrdfTree:
             stack.append(joint.child)
     if len(reached) != len(links):
         lost = [name for name in links if name not in reached]
-        raise ValueError(f"urdf: links {lost[:5]} are not connected to the root {roots[0]!r} "
-                         "(a cycle of joints)")
+        raise ValueError(
+            f"urdf: links {lost[:5]} are not connected to the root {roots[0]!r} (a cycle of joints)"
+        )
     return tree
 
 
@@ -134,8 +145,10 @@ def serial_chain(tree: UrdfTree, base_link: str | None, tip_link: str | None) ->
             raise ValueError(f"urdf: no movable joint below {base!r}")
         if len(leaves) != 1:
             found = ", ".join(repr(leaf) for leaf in leaves)
-            raise ValueError(f"tip_link: the tree below {base!r} has {len(leaves)} leaves reached "
-                             f"through movable joints ({found}); pass tip_link= to choose one")
+            raise ValueError(
+                f"tip_link: the tree below {base!r} has {len(leaves)} leaves reached "
+                f"through movable joints ({found}); pass tip_link= to choose one"
+            )
         tip = leaves[0]
     else:
         tip = _link_name(tree, tip_link, "tip_link")
@@ -149,11 +162,15 @@ def serial_chain(tree: UrdfTree, base_link: str | None, tip_link: str | None) ->
     chain.reverse()
     for joint in chain:
         if joint.type in ("floating", "planar"):
-            raise ValueError(f"joint {joint.name!r}: a {joint.type} joint is not a joint of a "
-                             "serial arm (only revolute, continuous, prismatic and fixed)")
+            raise ValueError(
+                f"joint {joint.name!r}: a {joint.type} joint is not a joint of a "
+                "serial arm (only revolute, continuous, prismatic and fixed)"
+            )
         if joint.mimic and joint.type in MOVABLE:
-            raise ValueError(f"joint {joint.name!r}: a mimic joint (coupled to another) cannot be "
-                             "an independent DH joint")
+            raise ValueError(
+                f"joint {joint.name!r}: a mimic joint (coupled to another) cannot be "
+                "an independent DH joint"
+            )
     if not any(joint.type in MOVABLE for joint in chain):
         raise ValueError(f"urdf: no movable joint between {base!r} and {tip!r}")
     return chain
@@ -174,8 +191,10 @@ def _moving_leaves(tree: UrdfTree, base: str) -> list[str]:
 def _link_name(tree: UrdfTree, name: object, argument: str) -> str:
     if not isinstance(name, str) or name not in tree.links:
         known = ", ".join(list(tree.links)[:12])
-        raise ValueError(f"{argument}: no link named {name!r} in the URDF (links: {known}"
-                         f"{', ...' if len(tree.links) > 12 else ''})")
+        raise ValueError(
+            f"{argument}: no link named {name!r} in the URDF (links: {known}"
+            f"{', ...' if len(tree.links) > 12 else ''})"
+        )
     return name
 
 
@@ -197,8 +216,9 @@ def _name(element: ET.Element, what: str) -> str:
     return name
 
 
-def _floats(element: ET.Element | None, attribute: str, count: int, default: str, where: str
-            ) -> Array:
+def _floats(
+    element: ET.Element | None, attribute: str, count: int, default: str, where: str
+) -> Array:
     text = default if element is None else element.get(attribute, default)
     try:
         values = np.array([float(v) for v in text.split()])
@@ -231,11 +251,17 @@ def _inertial(element: ET.Element | None, link: str) -> Inertial | None:
     if mass_element is None or inertia_element is None:
         raise ValueError(f"{where}: expected <mass> and <inertia>")
     mass = _number(mass_element, "value", f"{where} <mass>")
-    i = {k: _number(inertia_element, k, f"{where} <inertia>")
-         for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-    inertia = np.array([[i["ixx"], i["ixy"], i["ixz"]],
-                        [i["ixy"], i["iyy"], i["iyz"]],
-                        [i["ixz"], i["iyz"], i["izz"]]])
+    i = {
+        k: _number(inertia_element, k, f"{where} <inertia>")
+        for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+    }
+    inertia = np.array(
+        [
+            [i["ixx"], i["ixy"], i["ixz"]],
+            [i["ixy"], i["iyy"], i["iyz"]],
+            [i["ixz"], i["iyz"], i["izz"]],
+        ]
+    )
     return Inertial(mass, _origin(element.find("origin"), where), inertia)
 
 
@@ -244,14 +270,17 @@ def _joint(element: ET.Element, links: dict[str, Inertial | None]) -> Joint:
     where = f"joint {name!r}"
     kind = element.get("type")
     if kind not in JOINT_TYPES:
-        raise ValueError(f"{where}: unknown type {kind!r}, expected one of {', '.join(JOINT_TYPES)}")
+        raise ValueError(
+            f"{where}: unknown type {kind!r}, expected one of {', '.join(JOINT_TYPES)}"
+        )
     ends = {}
     for end in ("parent", "child"):
         tag = element.find(end)
         ends[end] = None if tag is None else tag.get("link")
         if ends[end] not in links:
-            raise ValueError(f"{where}: <{end} link=...> names no link of the URDF "
-                             f"(got {ends[end]!r})")
+            raise ValueError(
+                f"{where}: <{end} link=...> names no link of the URDF (got {ends[end]!r})"
+            )
     axis = _floats(element.find("axis"), "xyz", 3, "1 0 0", f"{where} <axis>")
     norm = float(np.linalg.norm(axis))
     if kind in MOVABLE:
@@ -260,12 +289,17 @@ def _joint(element: ET.Element, links: dict[str, Inertial | None]) -> Joint:
         axis = axis / norm
     limit = element.find("limit")
     limits = None
-    if kind in ("revolute", "prismatic") and limit is not None and (
-            limit.get("lower") is not None or limit.get("upper") is not None):
+    if (
+        kind in ("revolute", "prismatic")
+        and limit is not None
+        and (limit.get("lower") is not None or limit.get("upper") is not None)
+    ):
         lower = _number(limit, "lower", f"{where} <limit>", "0")
         upper = _number(limit, "upper", f"{where} <limit>", "0")
         if not lower < upper:
-            raise ValueError(f"{where}: <limit lower={lower} upper={upper}>, expected lower < upper")
+            raise ValueError(
+                f"{where}: <limit lower={lower} upper={upper}>, expected lower < upper"
+            )
         limits = (lower, upper)
     dynamics = element.find("dynamics")
     damping = friction = 0.0
@@ -280,5 +314,16 @@ def _joint(element: ET.Element, links: dict[str, Inertial | None]) -> Joint:
             rotor = _number(ET.Element("x", {"Ia": match.group(1)}), "Ia", f"{where} comment")
     parent, child = ends["parent"], ends["child"]
     assert parent is not None and child is not None  # both name links (checked above)
-    return Joint(name, kind, parent, child, _origin(element.find("origin"), where),
-                 axis, limits, damping, friction, element.find("mimic") is not None, rotor)
+    return Joint(
+        name,
+        kind,
+        parent,
+        child,
+        _origin(element.find("origin"), where),
+        axis,
+        limits,
+        damping,
+        friction,
+        element.find("mimic") is not None,
+        rotor,
+    )

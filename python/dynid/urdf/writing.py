@@ -52,10 +52,13 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
     dh = np.asarray(robot.dh, dtype=float)
     standard = robot.convention == "standard"
     root = ET.Element("robot", name=name)
-    root.append(ET.Comment(
-        f" Written by dynid from a {robot.n}-joint {robot.convention}-DH model. Link i's frame "
-        "is joint i's frame (z on its axis); the inertial origins give DH frame i's axes. "
-        "Effort and velocity limits are not part of a dynid model (written as 0). "))
+    root.append(
+        ET.Comment(
+            f" Written by dynid from a {robot.n}-joint {robot.convention}-DH model. Link i's frame "
+            "is joint i's frame (z on its axis); the inertial origins give DH frame i's axes. "
+            "Effort and velocity limits are not part of a dynid model (written as 0). "
+        )
+    )
     ET.SubElement(root, "link", name="base_link")
     parent_to_joint = robot.base @ (np.eye(4) if standard else _rx_tx(dh[0]))
     for i in range(robot.n):
@@ -64,28 +67,52 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         mass, com, inertia = links[i]
         link = ET.SubElement(root, "link", name=f"link{i + 1}")
         inertial = ET.SubElement(link, "inertial")
-        ET.SubElement(inertial, "origin", xyz=_vector(offset[:3, :3] @ com + offset[:3, 3]),
-                      rpy=_vector(rpy(offset[:3, :3])))
+        ET.SubElement(
+            inertial,
+            "origin",
+            xyz=_vector(offset[:3, :3] @ com + offset[:3, 3]),
+            rpy=_vector(rpy(offset[:3, :3])),
+        )
         ET.SubElement(inertial, "mass", value=_number(mass))
-        ET.SubElement(inertial, "inertia", {
-            key: _number(inertia[r, c]) for key, (r, c) in
-            (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
-             ("iyz", (1, 2)), ("izz", (2, 2)))})
+        ET.SubElement(
+            inertial,
+            "inertia",
+            {
+                key: _number(inertia[r, c])
+                for key, (r, c) in (
+                    ("ixx", (0, 0)),
+                    ("ixy", (0, 1)),
+                    ("ixz", (0, 2)),
+                    ("iyy", (1, 1)),
+                    ("iyz", (1, 2)),
+                    ("izz", (2, 2)),
+                )
+            },
+        )
         kind = "prismatic" if robot.joint_types[i] == "P" else "revolute"
         joint = ET.SubElement(root, "joint", name=f"joint{i + 1}", type=kind)
-        joint.append(ET.Comment(
-            f' dynid: Ia="{_number(robot.Ia[i])}" (reflected rotor inertia [kg m^2], '
-            "added to M[i, i]; URDF has no field for it) "))
+        joint.append(
+            ET.Comment(
+                f' dynid: Ia="{_number(robot.Ia[i])}" (reflected rotor inertia [kg m^2], '
+                "added to M[i, i]; URDF has no field for it) "
+            )
+        )
         ET.SubElement(joint, "parent", link="base_link" if i == 0 else f"link{i}")
         ET.SubElement(joint, "child", link=f"link{i + 1}")
-        ET.SubElement(joint, "origin", xyz=_vector(parent_to_joint[:3, 3]),
-                      rpy=_vector(rpy(parent_to_joint[:3, :3])))
+        ET.SubElement(
+            joint,
+            "origin",
+            xyz=_vector(parent_to_joint[:3, 3]),
+            rpy=_vector(rpy(parent_to_joint[:3, :3])),
+        )
         ET.SubElement(joint, "axis", xyz="0 0 1")
         lower, upper = robot.qlim[i]
-        ET.SubElement(joint, "limit", lower=_number(lower), upper=_number(upper), effort="0",
-                      velocity="0")
-        ET.SubElement(joint, "dynamics", damping=_number(robot.Fv[i]),
-                      friction=_number(robot.Fs[i]))
+        ET.SubElement(
+            joint, "limit", lower=_number(lower), upper=_number(upper), effort="0", velocity="0"
+        )
+        ET.SubElement(
+            joint, "dynamics", damping=_number(robot.Fv[i]), friction=_number(robot.Fs[i])
+        )
         parent_to_joint = offset if standard or i + 1 == robot.n else offset @ _rx_tx(dh[i + 1])
     ET.SubElement(root, "link", name="tool")
     tool_joint = ET.SubElement(root, "joint", name="tool_joint", type="fixed")
@@ -101,8 +128,7 @@ def write_urdf(text: str, path: str | Path, overwrite: bool = False) -> Path:
     """Write ``text`` to ``path`` through a temporary file and a rename (the file is whole or
     absent). An existing file is a ValueError unless ``overwrite``."""
     if not isinstance(overwrite, bool):
-        raise ValueError(
-            f"overwrite: expected True or False, got {overwrite!r}")
+        raise ValueError(f"overwrite: expected True or False, got {overwrite!r}")
     if not isinstance(path, (str, Path)) or not str(path).strip():
         raise ValueError(f"path: expected a file path, got {path!r}")
     target = Path(path)
@@ -129,23 +155,37 @@ def rpy(rotation: Array) -> Array:
     pitch = float(np.arctan2(-rotation[2, 0], cos_pitch))
     if cos_pitch < 1e-10:  # gimbal lock: roll and yaw share an axis; put it all in roll
         return np.array([np.arctan2(-rotation[1, 2], rotation[1, 1]), pitch, 0.0])
-    return np.array([np.arctan2(rotation[2, 1], rotation[2, 2]), pitch,
-                     np.arctan2(rotation[1, 0], rotation[0, 0])])
+    return np.array(
+        [
+            np.arctan2(rotation[2, 1], rotation[2, 2]),
+            pitch,
+            np.arctan2(rotation[1, 0], rotation[0, 0]),
+        ]
+    )
 
 
 def _physical(params: Array, i: int) -> tuple[float, Array, Array]:
     mass = float(params[0])
     com = np.asarray(params[1:4]) / mass if mass > 0.0 else np.zeros(3)
-    about_origin = np.array([[params[4], params[5], params[6]],
-                             [params[5], params[7], params[8]],
-                             [params[6], params[8], params[9]]])
+    about_origin = np.array(
+        [
+            [params[4], params[5], params[6]],
+            [params[5], params[7], params[8]],
+            [params[6], params[8], params[9]],
+        ]
+    )
     inertia = about_origin - mass * ((com @ com) * np.eye(3) - np.outer(com, com))
-    why = f"mass {mass} is not positive" if not mass > 0.0 else _core.physical_inconsistency(
-        mass, inertia)
+    why = (
+        f"mass {mass} is not positive"
+        if not mass > 0.0
+        else _core.physical_inconsistency(mass, inertia)
+    )
     if why:
-        raise ValueError(f"robot: link {i + 1} is not physically consistent ({why}); a URDF link "
-                         "needs m > 0 and a positive definite inertia about its centre of mass "
-                         "that satisfies the triangle inequalities")
+        raise ValueError(
+            f"robot: link {i + 1} is not physically consistent ({why}); a URDF link "
+            "needs m > 0 and a positive definite inertia about its centre of mass "
+            "that satisfies the triangle inequalities"
+        )
     return mass, com, inertia
 
 
@@ -165,8 +205,9 @@ def _rx_tx(row: Array) -> Array:
     """Rx(alpha_{i-1}) Tx(a_{i-1}) of a modified row."""
     a, alpha = row[0], row[1]
     ca, sa = np.cos(alpha), np.sin(alpha)
-    return np.array([[1.0, 0.0, 0.0, a], [0.0, ca, -sa, 0.0], [0.0, sa, ca, 0.0],
-                     [0.0, 0.0, 0.0, 1.0]])
+    return np.array(
+        [[1.0, 0.0, 0.0, a], [0.0, ca, -sa, 0.0], [0.0, sa, ca, 0.0], [0.0, 0.0, 0.0, 1.0]]
+    )
 
 
 def _number(value: float) -> str:

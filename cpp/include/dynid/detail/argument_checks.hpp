@@ -42,11 +42,10 @@ inline WorkspaceBuffers& checked_buffers(const char* function, const Model& mode
 }  // namespace dynid::detail
 
 // Inside a public algorithm: the argument's name is its spelling, the function is __func__.
-#define DYNID_CHECK_JOINT_VECTOR(argument, model)                                                \
-  ::dynid::detail::check_size(__func__, #argument, (argument).size(), (model).n(),              \
-                              "one per joint")
-#define DYNID_CHECK_SHAPE(argument, expected_rows, expected_cols)                                 \
-  ::dynid::detail::check_shape(__func__, #argument, (argument).rows(), (argument).cols(),       \
+#define DYNID_CHECK_JOINT_VECTOR(argument, model) \
+  ::dynid::detail::check_size(__func__, #argument, (argument).size(), (model).n(), "one per joint")
+#define DYNID_CHECK_SHAPE(argument, expected_rows, expected_cols)                         \
+  ::dynid::detail::check_shape(__func__, #argument, (argument).rows(), (argument).cols(), \
                                (expected_rows), (expected_cols))
 #define DYNID_CHECKED_BUFFERS(model, workspace) \
   ::dynid::detail::checked_buffers(__func__, (model), (workspace))

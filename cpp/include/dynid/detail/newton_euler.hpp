@@ -11,8 +11,8 @@ namespace dynid::detail {
 // The links' share B(q) qdd + c(q, qd) [+ g(q)]. base_acceleration is the linear acceleration of
 // frame 0 in its own axes: -gravity_base() includes gravity (the usual fictitious upward
 // acceleration), zero leaves it out.
-void newton_euler(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd,
-                  const VectorIn& qdd, const Vector3& base_acceleration, VectorOut tau);
+void newton_euler(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd, const VectorIn& qdd,
+                  const Vector3& base_acceleration, VectorOut tau);
 
 // Forward pass: ws.omega, ws.omegad and ws.a (linear acceleration of each joint-frame origin).
 void propagate_motion(const Model& model, WorkspaceBuffers& ws, const VectorIn& qd,

@@ -24,7 +24,8 @@ inline Vector6 force_cross(const Vector6& m, const Vector6& f) {
   return out;
 }
 
-// Spatial inertia (m, h = m c, I about the origin) times a motion [w; u]: [I w + h x u; m u - h x w].
+// Spatial inertia (m, h = m c, I about the origin) times a motion [w; u]: [I w + h x u; m u - h x
+// w].
 inline Vector6 inertia_times(const RigidBodyParameters& b, const Vector6& x) {
   Vector6 out;
   out << b.I * x.head<3>() + b.h.cross(x.tail<3>()), b.m * x.tail<3>() - b.h.cross(x.head<3>());
