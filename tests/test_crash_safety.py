@@ -179,6 +179,10 @@ import signal, sys, time
 import numpy as np
 import dynid
 
+# A process started in the background by a non-interactive shell inherits SIGINT ignored, and
+# Python then leaves it ignored: restore Python's handler, as an interactive session has it.
+signal.signal(signal.SIGINT, signal.default_int_handler)
+
 # A 100-joint chain: forward dynamics costs ~0.2 ms per sample here, so 25000 samples take
 # several seconds (60 MB of input).
 n = 100

@@ -355,12 +355,20 @@ def test_a_long_run_stops_on_keyboard_interrupt(lwr):
     import threading
     import time
 
+    import signal
+
+    # interrupt_main does nothing while SIGINT is ignored (pytest started in the background by a
+    # non-interactive shell inherits that): Python's own handler, as in an interactive session.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.2, _thread.interrupt_main)
     start = time.perf_counter()
     timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        simulate(lwr, Q0, QD0, 100.0, PDGravity(lwr, KP, KD, np.zeros(7)), substeps=50)
-    timer.join()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            simulate(lwr, Q0, QD0, 100.0, PDGravity(lwr, KP, KD, np.zeros(7)), substeps=50)
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
     assert time.perf_counter() - start < 5.0
 
 

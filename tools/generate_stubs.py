@@ -42,6 +42,8 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     "q": ARRAY_LIKE,
     "qd": ARRAY_LIKE,
     "qdd": ARRAY_LIKE,
+    "qddd": ARRAY_LIKE,
+    "qdddd": ARRAY_LIKE,
     "tau": ARRAY_LIKE,
     # batch outputs: a preallocated result array, the regressor's selected columns
     "out": f"{ARRAY} | None",
@@ -83,6 +85,20 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     ("_simulate", "qd_d"): f"{ARRAY_LIKE} | None",
     ("_simulate", "qdd_d"): f"{ARRAY_LIKE} | None",
     ("_simulate", "function"): (f"typing.Callable[[float, {ARRAY}, {ARRAY}], {ARRAY_LIKE}] | None"),
+    # elastic-joint simulation (dynid.sim.simulate_elastic checks and passes these)
+    "stiffness": ARRAY_LIKE,
+    "motor_inertia": ARRAY_LIKE,
+    "motor_viscous": ARRAY_LIKE,
+    "motor_coulomb": ARRAY_LIKE,
+    "thetad0": ARRAY_LIKE,
+    ("_simulate_elastic", "theta0"): ARRAY_LIKE,
+    ("_simulate_elastic", "kp"): ARRAY_LIKE,
+    ("_simulate_elastic", "kd"): ARRAY_LIKE,
+    ("_simulate_elastic", "q_d"): ARRAY_LIKE,
+    ("_simulate_elastic", "function"): (
+        f"typing.Callable[[float, {ARRAY}, {ARRAY}, {ARRAY}, {ARRAY}, {ARRAY}], "
+        f"{ARRAY_LIKE}] | None"
+    ),
 }
 
 # Property setters (their single argument is unnamed in pybind11), by property name.

@@ -24,12 +24,12 @@ Array as_real_array(py::handle obj, const char* name);
 // Raises ValueError when the array holds NaN or inf.
 void require_finite(const Array& a, const char* name);
 
-// One to three per-sample arguments (q, qd, ...): each (n,) for one sample or (T, n) for T.
+// One to five per-sample arguments (q, qd, ...): each (n,) for one sample or (T, n) for T.
 // Fixed-size storage: parsing a single sample allocates nothing beyond NumPy's own objects.
 struct Samples {
-  static constexpr std::size_t kMaxArguments = 3;
+  static constexpr std::size_t kMaxArguments = 5;
   py::object owners[kMaxArguments];  // keep converted arrays alive
-  const double* data[kMaxArguments] = {nullptr, nullptr, nullptr};
+  const double* data[kMaxArguments] = {};
   std::string names;  // "q, qd, qdd": for errors about the result
   std::size_t size = 0;
   py::ssize_t count = 1;  // T

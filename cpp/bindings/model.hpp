@@ -78,7 +78,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   double* out_data = out.mutable_data();
   const std::size_t arguments = s.size;
   if (s.single) {
-    const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+    const double* in[Samples::kMaxArguments] = {};
     for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
     if (!all_finite(out_data, per_sample))
@@ -92,7 +92,7 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   std::atomic<py::ssize_t> first_bad{s.count};  // the first sample with a non-finite output
   auto make_worker = [&] {
     return [&, ws = Workspace(*model)](py::ssize_t begin, py::ssize_t end) mutable {
-      const double* in[4] = {nullptr, nullptr, nullptr, nullptr};
+      const double* in[Samples::kMaxArguments] = {};
       for (py::ssize_t t = begin; t < end; ++t) {
         for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
         double* sample = out_data + t * per_sample;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "elastic.hpp"
 #include "fast_calls.hpp"
 #include "lanes.hpp"
 #include "model.hpp"
@@ -17,6 +18,8 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
   dynid::binding::bind_model(m);
   dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
+  // adds rnea_time_derivatives to Model (after bind_model) and the elastic simulator
+  dynid::binding::bind_elastic(m);
   dynid::binding::bind_lanes(m);
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);

@@ -27,6 +27,7 @@ WorkspaceBuffers::WorkspaceBuffers(int joints)
       M(MatrixX::Zero(n, n)),
       bias(VectorX::Zero(n)),
       cholesky(n),
-      derivatives(n) {}
+      derivatives(n),
+      time_derivatives(n) {}
 
 }  // namespace dynid::detail

@@ -37,6 +37,8 @@ if TYPE_CHECKING:
     from . import models
     from .bounds import DynamicBounds, dynamic_bounds
     from .cmake import get_cmake_dir, get_include
+    from .elastic import ElasticRobot
+    from .elastic_identification import DriveIdentification, identify_drives
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
     from .identify import LeastSquaresResult, RankDeficientError, least_squares
@@ -90,6 +92,10 @@ _LAZY = {
     "VirtualController": ".sim",
     "simulate": ".sim",
     "DynamicBounds": ".bounds",
+    "ElasticRobot": ".elastic",
+    "elastic": ".elastic",
+    "DriveIdentification": ".elastic_identification",
+    "identify_drives": ".elastic_identification",
     "dynamic_bounds": ".bounds",
     "PayloadEstimate": ".payload",
     "estimate_payload": ".payload",
@@ -105,7 +111,9 @@ _LAZY = {
 # that it lists every name of _LAZY.
 __all__ = [
     "BaseParameters",
+    "DriveIdentification",
     "DynamicBounds",
+    "ElasticRobot",
     "FourierTrajectory",
     "IdentifiedModel",
     "LeastSquaresAccumulator",
@@ -123,11 +131,13 @@ __all__ = [
     "__version__",
     "base_parameters",
     "dynamic_bounds",
+    "elastic",
     "estimate_payload",
     "excitation",
     "get_cmake_dir",
     "get_include",
     "get_threads",
+    "identify_drives",
     "identify_from_controller",
     "identify_log",
     "io",

@@ -261,6 +261,21 @@ class Model:
         """
         Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, n, n) each for T samples (Carpentier & Mansard 2018); dtau_dqd includes diag(Fv), dtau/dqdd is mass_matrix(q). Both are views into one (2, n, n) or (T, 2, n, n) array.
         """
+    def rnea_time_derivatives(
+        self,
+        q: numpy.typing.ArrayLike,
+        qd: numpy.typing.ArrayLike,
+        qdd: numpy.typing.ArrayLike,
+        qddd: numpy.typing.ArrayLike,
+        qdddd: numpy.typing.ArrayLike,
+    ) -> tuple[
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+        numpy.typing.NDArray[numpy.float64],
+    ]:
+        """
+        Inverse dynamics and its exact first and second time derivatives (tau, tau_dot, tau_ddot) along a motion with joint derivatives qd, qdd, qddd (jerk) and qdddd (snap): (n,) each, or (T, n) each for T samples (views into one (3, n) or (T, 3, n) array). tau equals rnea(q, qd, qdd) (links, gravity and drive terms); tau_dot = dtau/dq qd + dtau/dqd qdd + M qddd, tau_ddot its time derivative. Drive terms are included (Ia qddd + Fv qdd and Ia qdddd + Fv qddd); Coulomb friction is flat away from qd = 0. Use robot.rigid_body() for the links alone (the link side of ElasticRobot).
+        """
     @property
     def Fs(self) -> numpy.typing.NDArray[numpy.float64]:
         """
@@ -528,6 +543,48 @@ def _simulate(
 ]:
     """
     Closed-loop simulation (use dynid.sim.simulate): returns q, qd, qdd, tau and the measured q (or None), each (periods + 1, n).
+    """
+
+def _simulate_elastic(
+    links: Model,
+    stiffness: numpy.typing.ArrayLike,
+    motor_inertia: numpy.typing.ArrayLike,
+    motor_viscous: numpy.typing.ArrayLike,
+    motor_coulomb: numpy.typing.ArrayLike,
+    q0: numpy.typing.ArrayLike,
+    qd0: numpy.typing.ArrayLike,
+    theta0: numpy.typing.ArrayLike,
+    thetad0: numpy.typing.ArrayLike,
+    periods: typing.SupportsInt | typing.SupportsIndex,
+    dt: typing.SupportsFloat | typing.SupportsIndex,
+    substeps: typing.SupportsInt | typing.SupportsIndex,
+    coulomb_band: typing.SupportsFloat | typing.SupportsIndex,
+    kind: str,
+    kp: numpy.typing.ArrayLike,
+    kd: numpy.typing.ArrayLike,
+    q_d: numpy.typing.ArrayLike,
+    function: typing.Callable[
+        [
+            float,
+            numpy.typing.NDArray[numpy.float64],
+            numpy.typing.NDArray[numpy.float64],
+            numpy.typing.NDArray[numpy.float64],
+            numpy.typing.NDArray[numpy.float64],
+            numpy.typing.NDArray[numpy.float64],
+        ],
+        numpy.typing.ArrayLike,
+    ]
+    | None,
+) -> tuple[
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+    numpy.typing.NDArray[numpy.float64],
+]:
+    """
+    Closed-loop simulation of an elastic-joint robot (use dynid.sim.simulate_elastic): returns q, qd, theta, thetad, tau, tau_J, each (periods + 1, n).
     """
 
 def _sincos(

@@ -7,10 +7,14 @@
 - :class:`VirtualController` reports what the LWR's interface reports (numeric M(q), g(q),
   measured q and joint torques along a motion tracked in closed loop):
   :mod:`~dynid.sim.virtual_controller`.
+- :func:`simulate_elastic` runs a robot with elastic joints (:class:`dynid.ElasticRobot`) the
+  same way (C++ RK4, zero-order hold; zero torque, :class:`MotorPD` or a Python controller):
+  :mod:`~dynid.sim.elastic_joints`.
 """
 
 from .closed_loop import Simulation, plant_friction, simulate
 from .controllers import PD, ComputedTorque, PDGravity
+from .elastic_joints import ElasticSimulation, MotorPD, simulate_elastic
 from .virtual_controller import (
     StaticReadings,
     TorqueRecording,
@@ -21,6 +25,8 @@ from .virtual_controller import (
 __all__ = [
     "PD",
     "ComputedTorque",
+    "ElasticSimulation",
+    "MotorPD",
     "PDGravity",
     "Simulation",
     "StaticReadings",
@@ -29,4 +35,5 @@ __all__ = [
     "paper_validation_trajectory",
     "plant_friction",
     "simulate",
+    "simulate_elastic",
 ]

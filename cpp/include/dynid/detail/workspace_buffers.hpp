@@ -8,6 +8,7 @@
 
 #include "dynid/detail/derivative_buffers.hpp"
 #include "dynid/detail/joint_transform.hpp"
+#include "dynid/detail/time_derivative_buffers.hpp"
 #include "dynid/rigid_body.hpp"
 #include "dynid/types.hpp"
 
@@ -62,6 +63,9 @@ struct WorkspaceBuffers {
 
   // Analytic derivatives (rnea_derivatives.cpp).
   DerivativeBuffers derivatives;
+
+  // Time derivatives of inverse dynamics (rnea_time_derivatives.cpp).
+  TimeDerivativeBuffers time_derivatives;
 };
 
 }  // namespace dynid::detail

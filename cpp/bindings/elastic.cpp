@@ -1,0 +1,144 @@
+// Binding of rnea_time_derivatives (registered onto the Model class of model.cpp, single sample
+// or a batch looped in C++ by evaluate(), GIL released) and of the elastic-joint simulator (the
+// whole run in C++ without the GIL; a Python controller takes it back for its call only).
+#include "elastic.hpp"
+
+#include <memory>
+#include <string>
+
+#include "arrays.hpp"
+#include "dynid/elastic_simulator.hpp"
+#include "model.hpp"
+
+namespace dynid::binding {
+namespace {
+
+// controller(t, q, qd, theta, thetad, tau_J) -> tau, called with the GIL held.
+class PythonElasticController : public ElasticController {
+ public:
+  PythonElasticController(py::object function, int n) : function_(std::move(function)), n_(n) {}
+
+  void command(int, double t, const VectorIn& q, const VectorIn& qd, const VectorIn& theta,
+               const VectorIn& thetad, const VectorIn& tau_J, VectorOut tau) override {
+    py::gil_scoped_acquire gil;
+    const auto copy = [this](const VectorIn& v) {
+      py::array_t<double> a(n_);
+      Eigen::Map<VectorX>(a.mutable_data(), n_) = v;
+      return a;
+    };
+    py::object result = function_(t, copy(q), copy(qd), copy(theta), copy(thetad), copy(tau_J));
+    const Array a = as_real_array(result, "controller");
+    if (a.ndim() != 1 || a.shape(0) != n_)
+      throw py::value_error("controller: expected the callable to return " + std::to_string(n_) +
+                            " torques, shape (" + std::to_string(n_) + ",), got shape " +
+                            shape_string(a) + " at t = " + std::to_string(t) + " s");
+    require_finite(a, "controller");
+    tau = Eigen::Map<const VectorX>(a.data(), n_);
+  }
+
+ private:
+  py::object function_;
+  int n_;
+};
+
+// Zero motor torque: free motion.
+class ZeroTorque : public ElasticController {
+ public:
+  void command(int, double, const VectorIn&, const VectorIn&, const VectorIn&, const VectorIn&,
+               const VectorIn&, VectorOut tau) override {
+    tau.setZero();
+  }
+};
+
+VectorX vector_argument(py::handle obj, const char* name, int n) {
+  const Array a = parse_fixed(obj, name, {n});
+  return Eigen::Map<const VectorX>(a.data(), n);
+}
+
+}  // namespace
+
+void bind_elastic(py::module_& m) {
+  auto model = py::reinterpret_borrow<py::class_<PyModel>>(m.attr("Model"));
+  model.def(
+      "rnea_time_derivatives",
+      [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle qddd,
+         py::handle qdddd) {
+        const int n = self.model->n();
+        const Samples s = parse_samples(
+            {{q, "q"}, {qd, "qd"}, {qdd, "qdd"}, {qddd, "qddd"}, {qdddd, "qdddd"}}, n);
+        // The three vectors of a sample in one block: out[..., 0, :] = tau, 1: tau_dot, 2:
+        // tau_ddot.
+        py::array all =
+            evaluate(self, s, {3, n},
+                     [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
+                       OutVec tau(out, n), tau_dot(out + n, n), tau_ddot(out + 2 * n, n);
+                       rnea_time_derivatives(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n),
+                                             ConstVec(in[2], n), ConstVec(in[3], n),
+                                             ConstVec(in[4], n), tau, tau_dot, tau_ddot);
+                     });
+        const auto part = [&](int k) {
+          return py::array(s.single ? all[py::int_(k)]
+                                    : all[py::make_tuple(py::ellipsis(), k, py::slice())]);
+        };
+        return py::make_tuple(part(0), part(1), part(2));
+      },
+      py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("qddd"), py::arg("qdddd"),
+      "Inverse dynamics and its exact first and second time derivatives (tau, tau_dot, tau_ddot) "
+      "along a motion with joint derivatives qd, qdd, qddd (jerk) and qdddd (snap): (n,) each, or "
+      "(T, n) each for T samples (views into one (3, n) or (T, 3, n) array). tau equals rnea(q, "
+      "qd, "
+      "qdd) (links, gravity and drive terms); tau_dot = dtau/dq qd + dtau/dqd qdd + M qddd, "
+      "tau_ddot its time derivative. Drive terms are included (Ia qddd + Fv qdd and Ia qdddd + Fv "
+      "qddd); Coulomb friction is flat away from qd = 0. Use robot.rigid_body() for the links "
+      "alone (the link side of ElasticRobot).");
+
+  m.def(
+      "_simulate_elastic",
+      [](PyModel& links, py::handle K, py::handle B, py::handle Fv, py::handle Fs, py::handle q0,
+         py::handle qd0, py::handle theta0, py::handle thetad0, int periods, double dt,
+         int substeps, double coulomb_band, const std::string& kind, py::handle kp, py::handle kd,
+         py::handle q_d, py::object function) {
+        const int n = links.model->n();
+        if (periods < 1) throw py::value_error("duration: expected at least one control period");
+        std::shared_ptr<const Model> model = links.model;
+        const ElasticDrives drives{
+            vector_argument(K, "stiffness", n), vector_argument(B, "motor_inertia", n),
+            vector_argument(Fv, "motor_viscous", n), vector_argument(Fs, "motor_coulomb", n)};
+        ElasticSimulator simulator(*model, drives, dt, substeps, coulomb_band);
+        std::unique_ptr<ElasticController> controller;
+        if (kind == "callable")
+          controller = std::make_unique<PythonElasticController>(function, n);
+        else if (kind == "motor_pd")
+          controller = std::make_unique<MotorPDController>(
+              *model, drives, vector_argument(kp, "kp", n), vector_argument(kd, "kd", n),
+              vector_argument(q_d, "q_d", n));
+        else if (kind == "none")
+          controller = std::make_unique<ZeroTorque>();
+        else
+          throw py::value_error("controller: unknown kind '" + kind + "'");
+        const VectorX x_q = vector_argument(q0, "q0", n), x_qd = vector_argument(qd0, "qd0", n);
+        const VectorX x_th = vector_argument(theta0, "theta0", n),
+                      x_thd = vector_argument(thetad0, "thetad0", n);
+        const py::ssize_t rows = static_cast<py::ssize_t>(periods) + 1, cols = n;
+        py::array_t<double> q({rows, cols}), qd({rows, cols}), th({rows, cols}), thd({rows, cols}),
+            tau({rows, cols}), tau_J({rows, cols});
+        ElasticSimulationOutput out{
+            RowMajorMap(q.mutable_data(), rows, n),   RowMajorMap(qd.mutable_data(), rows, n),
+            RowMajorMap(th.mutable_data(), rows, n),  RowMajorMap(thd.mutable_data(), rows, n),
+            RowMajorMap(tau.mutable_data(), rows, n), RowMajorMap(tau_J.mutable_data(), rows, n)};
+        {
+          py::gil_scoped_release release;
+          simulator.run(*controller, x_q, x_qd, x_th, x_thd, periods, out);
+        }
+        return py::make_tuple(q, qd, th, thd, tau, tau_J);
+      },
+      py::arg("links"), py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
+      py::arg("motor_coulomb"), py::arg("q0"), py::arg("qd0"), py::arg("theta0"),
+      py::arg("thetad0"), py::arg("periods"), py::arg("dt"), py::arg("substeps"),
+      py::arg("coulomb_band"), py::arg("kind"), py::arg("kp"), py::arg("kd"), py::arg("q_d"),
+      py::arg("function"),
+      "Closed-loop simulation of an elastic-joint robot (use dynid.sim.simulate_elastic): returns "
+      "q, qd, theta, thetad, tau, tau_J, each (periods + 1, n).");
+}
+
+}  // namespace dynid::binding
