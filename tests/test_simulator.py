@@ -352,10 +352,9 @@ def test_a_long_run_stops_on_keyboard_interrupt(lwr):
     # of 50 RK4 substeps, 2*10^7 forward dynamics: 20 s or more) within 5 s: the binding lets
     # Python handle signals every 1000 periods.
     import _thread
+    import signal
     import threading
     import time
-
-    import signal
 
     # interrupt_main does nothing while SIGINT is ignored (pytest started in the background by a
     # non-interactive shell inherits that): Python's own handler, as in an interactive session.
