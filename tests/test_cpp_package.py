@@ -28,16 +28,10 @@ from pathlib import Path
 import pytest
 
 import dynid.cmake
+from cpp_programs import find_compiler
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "cpp" / "examples"
-
-
-def find_compiler() -> str | None:
-    for candidate in (os.environ.get("CXX"), "g++", "c++", "clang++"):
-        if candidate and shutil.which(candidate):
-            return shutil.which(candidate)
-    return None
 
 
 def find_tool(name: str) -> str | None:

@@ -27,9 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import re
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +35,7 @@ import pytest
 
 import dynid
 from conftest import ARM_CASES, make_arm
-from test_recursive import find_compiler, find_eigen
+from cpp_programs import build_and_run
 from test_rnea_time_derivatives import D1, D2, relative_error, sine_motion
 
 REPO = Path(__file__).resolve().parents[1]
@@ -302,33 +300,6 @@ def test_no_heap_allocation_per_call(tmp_path):
     """Compiles tests/cpp/test_elastic_no_allocation.cpp with the core's sources and runs it: it
     counts every operator new and malloc during 10^4 rnea_time_derivatives calls, checks tau
     against rnea, and that size errors name the argument."""
-    compiler = find_compiler()
-    if compiler is None:
-        assert not os.environ.get("CI"), "CI needs a C++ compiler (CXX, g++, c++, clang++)"
-        pytest.skip("no C++ compiler found (CXX, g++, c++, clang++)")
-    program = tmp_path / "test_elastic_no_allocation"
-    sources = sorted(str(p) for p in (REPO / "cpp" / "src").glob("*.cpp"))
-    build = subprocess.run(
-        [
-            compiler,
-            "-O1",
-            "-DNDEBUG",
-            "-std=c++17",
-            f"-I{REPO / 'cpp' / 'include'}",
-            f"-I{REPO / 'cpp' / 'examples'}",
-            f"-I{find_eigen()}",
-            str(REPO / "tests" / "cpp" / "test_elastic_no_allocation.cpp"),
-            *sources,
-            "-o",
-            str(program),
-        ],
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=900,
-    )
-    assert build.returncode == 0, build.stderr
-    run = subprocess.run([str(program)], check=False, capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stdout + run.stderr
-    assert re.search(r"^allocations_during_calls=0$", run.stdout, re.MULTILINE), run.stdout
-    print(run.stdout)
+    output = build_and_run(tmp_path, "test_elastic_no_allocation", optimisation="-O1")
+    assert re.search(r"^allocations_during_calls=0$", output, re.MULTILINE), output
+    print(output)

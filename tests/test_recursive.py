@@ -19,11 +19,7 @@ computations, on the KUKA LWR4 base regressor (7 x 43 blocks) where the issue as
 from __future__ import annotations
 
 import copy
-import os
 import re
-import shutil
-import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -34,6 +30,7 @@ from hypothesis import given, settings
 from numpy.typing import NDArray
 
 import dynid
+from cpp_programs import build_and_run
 
 RLS = dynid.RecursiveLeastSquares
 REPO = Path(__file__).resolve().parents[1]
@@ -470,60 +467,16 @@ def test_accepted_input_forms():
 # --------------------------------------------------------------------------- real time
 
 
-def find_compiler() -> str | None:
-    for candidate in (os.environ.get("CXX"), "g++", "c++", "clang++"):
-        if candidate and shutil.which(candidate):
-            return shutil.which(candidate)
-    return None
-
-
-def find_eigen() -> Path:
-    """Eigen's include folder: the cmeel-eigen wheel (as in CMakeLists.txt), else the system."""
-    for entry in map(Path, sys.path):
-        candidate = entry / "cmeel.prefix" / "include" / "eigen3"
-        if (candidate / "Eigen" / "Core").is_file():
-            return candidate
-    for candidate in (Path("/usr/include/eigen3"), Path("/usr/local/include/eigen3")):
-        if (candidate / "Eigen" / "Core").is_file():
-            return candidate
-    pytest.fail("Eigen not found: pip install cmeel-eigen (or install the system's eigen3)")
-
-
 def test_update_makes_no_heap_allocation(tmp_path, record_property):
     """Compiles tests/cpp/test_rls_no_allocation.cpp with the build's flags (-O3 -DNDEBUG) and
     runs it: it counts every operator new and malloc during 10^4 updates with 7 x 43 blocks (and
     blocks of 1..24 rows) and exits non-zero on any. Skipped only without a C++ compiler."""
-    compiler = find_compiler()
-    if compiler is None:
-        # In CI the zero-allocation proof must run, not be skipped.
-        assert not os.environ.get("CI"), "CI needs a C++ compiler (CXX, g++, c++, clang++)"
-        pytest.skip("no C++ compiler found (CXX, g++, c++, clang++)")
-    program = tmp_path / "test_rls_no_allocation"
-    build = subprocess.run(
-        [
-            compiler,
-            "-O3",
-            "-DNDEBUG",
-            "-std=c++17",
-            f"-I{REPO / 'cpp' / 'include'}",
-            f"-I{REPO / 'cpp' / 'examples'}",  # allocation_counter.hpp
-            f"-I{find_eigen()}",
-            str(REPO / "tests" / "cpp" / "test_rls_no_allocation.cpp"),
-            str(REPO / "cpp" / "src" / "recursive_least_squares.cpp"),
-            "-o",
-            str(program),
-        ],
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=600,
+    output = build_and_run(
+        tmp_path, "test_rls_no_allocation", ["recursive_least_squares"], optimisation="-O3"
     )
-    assert build.returncode == 0, build.stderr
-    run = subprocess.run([str(program)], check=False, capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stdout + run.stderr
-    assert re.search(r"^allocations_during_updates=0$", run.stdout, re.MULTILINE), run.stdout
-    timing = re.search(r"us_per_update_median=([0-9.]+)", run.stdout)
-    assert timing, run.stdout
+    assert re.search(r"^allocations_during_updates=0$", output, re.MULTILINE), output
+    timing = re.search(r"us_per_update_median=([0-9.]+)", output)
+    assert timing, output
     # Reported, not asserted (the machine may be busy): the target is < 10 us per update.
     record_property("us_per_update", float(timing.group(1)))
-    print(run.stdout)
+    print(output)

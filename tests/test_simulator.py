@@ -11,17 +11,14 @@ built-in one; the encoder's quantisation formula; the C++ no-allocation proof.
 
 from __future__ import annotations
 
-import os
 import re
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import dynid
+from cpp_programs import build_and_run
 from dynid.sim import (
     PD,
     ComputedTorque,
@@ -465,55 +462,10 @@ CORE_SOURCES = (
 )
 
 
-def find_compiler() -> str | None:
-    for candidate in (os.environ.get("CXX"), "g++", "c++", "clang++"):
-        if candidate and shutil.which(candidate):
-            return shutil.which(candidate)
-    return None
-
-
-def find_eigen() -> Path:
-    for entry in map(Path, sys.path):
-        candidate = entry / "cmeel.prefix" / "include" / "eigen3"
-        if (candidate / "Eigen" / "Core").is_file():
-            return candidate
-    for candidate in (Path("/usr/include/eigen3"), Path("/usr/local/include/eigen3")):
-        if (candidate / "Eigen" / "Core").is_file():
-            return candidate
-    pytest.fail("Eigen not found: pip install cmeel-eigen (or install the system's eigen3)")
-
-
 def test_simulator_runs_make_no_heap_allocation(tmp_path):
     """Compiles tests/cpp/test_simulator_no_allocation.cpp (-O2 -DNDEBUG) and runs it: every
     operator new and malloc is counted during runs with each built-in controller, both
     integrators, friction, noise and an encoder; it also checks the runs (energy, tracking)."""
-    compiler = find_compiler()
-    if compiler is None:
-        assert not os.environ.get("CI"), "CI needs a C++ compiler (CXX, g++, c++, clang++)"
-        pytest.skip("no C++ compiler found (CXX, g++, c++, clang++)")
-    program = tmp_path / "test_simulator_no_allocation"
-    sources = [str(REPO / "cpp" / "src" / f"{name}.cpp") for name in CORE_SOURCES]
-    build = subprocess.run(
-        [
-            compiler,
-            "-O2",
-            "-DNDEBUG",
-            "-std=c++17",
-            f"-I{REPO / 'cpp' / 'include'}",
-            f"-I{REPO / 'cpp' / 'examples'}",
-            f"-I{find_eigen()}",
-            str(REPO / "tests" / "cpp" / "test_simulator_no_allocation.cpp"),
-            *sources,
-            "-o",
-            str(program),
-        ],
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=900,
-    )
-    assert build.returncode == 0, build.stderr
-    run = subprocess.run([str(program)], check=False, capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stdout + run.stderr
-    assert re.search(r"^allocations_during_runs=0$", run.stdout, re.MULTILINE), run.stdout
-    assert re.search(r"^allocations_total=0$", run.stdout, re.MULTILINE), run.stdout
+    output = build_and_run(tmp_path, "test_simulator_no_allocation", CORE_SOURCES)
+    assert re.search(r"^allocations_during_runs=0$", output, re.MULTILINE), output
+    assert re.search(r"^allocations_total=0$", output, re.MULTILINE), output
