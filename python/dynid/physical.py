@@ -45,13 +45,12 @@ import scipy.linalg
 import scipy.linalg.lapack
 from numpy.typing import ArrayLike, NDArray
 
+from . import _checks as checks
 from ._checks import positive
 from ._equality import ValueEquality
 from .base_parameters import base_parameters
 from .physical_arguments import (
-    check_count,
     check_data,
-    check_flag,
     check_mass_bounds,
     check_prior,
     check_prior_weight,
@@ -183,10 +182,10 @@ def physical_least_squares(
     started = time.perf_counter()
     if not isinstance(robot, Robot):
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
-    rotor, friction = check_flag(rotor, "rotor"), check_flag(friction, "friction")
+    rotor, friction = checks.flag(rotor, "rotor"), checks.flag(friction, "friction")
     n = robot.n
     P = robot.parameter_vector(rotor, friction).size
-    k = check_count(extra_columns, "extra_columns")
+    k = checks.count(extra_columns, "extra_columns", 0)
     Y3, tau2 = check_data(Y, tau, n, P + k)
     w = check_weights(weights, Y3.shape[0], n)
     margin = positive(margin, "margin")

@@ -149,15 +149,3 @@ def check_total_mass(value: Any) -> tuple[float, float] | None:
             f"0 <= lower <= upper, upper > 0, got {value!r}"
         )
     return float(bounds[0]), float(bounds[1])
-
-
-def check_flag(value: Any, name: str) -> bool:
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    raise ValueError(f"{name}: expected True or False, got {value!r}")
-
-
-def check_count(value: Any, name: str) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"{name}: expected an integer >= 0, got {value!r}")
-    return int(value)
