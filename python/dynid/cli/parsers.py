@@ -93,17 +93,7 @@ def _add_identify(subcommands: Any) -> None:
     p.add_argument(
         "--outliers", type=float, metavar="K", help="drop torque spikes beyond K robust sigmas"
     )
-    p.add_argument(
-        "--output",
-        default="dynid-identify",
-        metavar="DIR",
-        help="output folder (default ./dynid-identify)",
-    )
-    p.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the output folder if it exists and is not empty",
-    )
+    _add_output(p, "dynid-identify")
     p.set_defaults(run=commands.identify)
 
 
@@ -117,17 +107,7 @@ def _add_validate(subcommands: Any) -> None:
     p.add_argument("result", help="result folder of `dynid identify`, or its result.json")
     p.add_argument("log", help="measurement log, .npz or .csv")
     _add_preparation(p)
-    p.add_argument(
-        "--output",
-        default="dynid-validate",
-        metavar="DIR",
-        help="output folder (default ./dynid-validate)",
-    )
-    p.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the output folder if it exists and is not empty",
-    )
+    _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
 
 
@@ -182,25 +162,8 @@ def _add_residual(subcommands: Any) -> None:
         metavar="T",
         help="draw +-T [N m] in the plot (a collision threshold)",
     )
-    p.add_argument("--skip", type=int, default=0, metavar="N", help="drop the first N samples")
-    p.add_argument("--columns", metavar="MAP", help="columns/keys of a foreign log (docs/data.md)")
-    p.add_argument(
-        "--time-unit",
-        choices=("s", "ms", "us", "ns"),
-        default="s",
-        help="unit of the log's time stamps (default s)",
-    )
-    p.add_argument(
-        "--output",
-        default="dynid-residual",
-        metavar="DIR",
-        help="output folder (default ./dynid-residual)",
-    )
-    p.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the output folder if it exists and is not empty",
-    )
+    _add_log_reading(p)
+    _add_output(p, "dynid-residual")
     p.set_defaults(run=commands.residual)
 
 
@@ -214,7 +177,19 @@ def _add_model(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _add_preparation(p: argparse.ArgumentParser) -> None:
+def _add_output(p: argparse.ArgumentParser, default: str) -> None:
+    p.add_argument(
+        "--output", default=default, metavar="DIR", help=f"output folder (default ./{default})"
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the output folder if it exists and is not empty",
+    )
+
+
+def _add_log_reading(p: argparse.ArgumentParser) -> None:
+    """The options of load_log (commands.log_options)."""
     p.add_argument(
         "--skip",
         type=int,
@@ -234,6 +209,11 @@ def _add_preparation(p: argparse.ArgumentParser) -> None:
         default="s",
         help="unit of the log's time stamps (default s)",
     )
+
+
+def _add_preparation(p: argparse.ArgumentParser) -> None:
+    """Reading the log, then the options of prepare_log (commands.preparation_options)."""
+    _add_log_reading(p)
     p.add_argument(
         "--cutoff",
         type=float,
