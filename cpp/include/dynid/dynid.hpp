@@ -12,6 +12,7 @@
 #include "dynid/friction.hpp"
 #include "dynid/gravity.hpp"
 #include "dynid/jacobian_dot.hpp"
+#include "dynid/kuka_like_controller.hpp"
 #include "dynid/kinematics.hpp"
 #include "dynid/model.hpp"
 #include "dynid/momentum_observer.hpp"
