@@ -164,14 +164,12 @@ void bind_elastic(py::module_& m) {
          py::handle qd0, py::handle theta0, py::handle thetad0, int periods, double dt,
          int substeps, double coulomb_band, PyModel& model, py::handle model_stiffness,
          py::handle kp, py::handle kd, py::handle torque_gain, py::handle torque_damping,
-         const std::string& gravity, py::handle q_d, py::handle qd_d,
-         py::handle tau_user) {
+         const std::string& gravity, py::handle q_d, py::handle qd_d, py::handle tau_user) {
         const int n = links.model->n();
         if (periods < 1) throw py::value_error("duration: expected at least one control period");
         if (model.model->n() != n)
-          throw py::value_error("model: expected the controller's model with " +
-                                std::to_string(n) + " joints, got " +
-                                std::to_string(model.model->n()));
+          throw py::value_error("model: expected the controller's model with " + std::to_string(n) +
+                                " joints, got " + std::to_string(model.model->n()));
         std::shared_ptr<const Model> plant = links.model, controller_model = model.model;
         const ElasticDrives drives = drives_argument(K, B, Fv, Fs, n);
         ElasticSimulator simulator(*plant, drives, dt, substeps, coulomb_band);
@@ -192,18 +190,17 @@ void bind_elastic(py::module_& m) {
           compensation = GravityCompensation::Static;
         else
           throw py::value_error("gravity: expected 'static' or 'desired', got '" + gravity + "'");
-        KukaLikeController controller(*controller_model,
-                                      vector_argument(model_stiffness, "stiffness", n), gains,
-                                      compensation, reference,
-                                      tau_user.is_none() ? nullptr : user.data());
+        KukaLikeController controller(
+            *controller_model, vector_argument(model_stiffness, "stiffness", n), gains,
+            compensation, reference, tau_user.is_none() ? nullptr : user.data());
         return run_elastic(simulator, controller, n, q0, qd0, theta0, thetad0, periods);
       },
       py::arg("links"), py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
       py::arg("motor_coulomb"), py::arg("q0"), py::arg("qd0"), py::arg("theta0"),
       py::arg("thetad0"), py::arg("periods"), py::arg("dt"), py::arg("substeps"),
       py::arg("coulomb_band"), py::arg("model"), py::arg("model_stiffness"), py::arg("kp"),
-      py::arg("kd"), py::arg("torque_gain"), py::arg("torque_damping"),
-      py::arg("gravity"), py::arg("q_d"), py::arg("qd_d"), py::arg("tau_user"),
+      py::arg("kd"), py::arg("torque_gain"), py::arg("torque_damping"), py::arg("gravity"),
+      py::arg("q_d"), py::arg("qd_d"), py::arg("tau_user"),
       "Elastic-joint simulation under the KUKA-like joint torque controller (use "
       "dynid.sim.simulate_elastic with dynid.sim.KukaLike): returns q, qd, theta, thetad, tau, "
       "tau_J, each (periods + 1, n).");

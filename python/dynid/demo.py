@@ -110,7 +110,14 @@ def run_demo(
         "torque_noise": torque_noise,
         "position_noise": position_noise,
     }
-    controller = VirtualController(truth, seed=seed, link_friction=link_friction, **noise)
+    controller = VirtualController(
+        truth,
+        seed=seed,
+        link_friction=link_friction,
+        model_noise=model_noise,
+        torque_noise=torque_noise,
+        position_noise=position_noise,
+    )
     training = controller.read_static(controller.random_configurations(train))
     checking = controller.read_static(controller.random_configurations(validation))
     step(
@@ -171,7 +178,11 @@ def run_demo(
 
     # 5. A second arm with the 250 g tip.
     tip_controller = VirtualController(
-        truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA), seed=seed + 1, **noise
+        truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA),
+        seed=seed + 1,
+        model_noise=model_noise,
+        torque_noise=torque_noise,
+        position_noise=position_noise,
     )
     tip = tip_controller.read_static(tip_controller.random_configurations(train))
     tip_ident = identify_from_controller(structure, tip.q, tip.g, tip.M)

@@ -38,8 +38,8 @@ class KukaLikeController : public ElasticController {
   // controller; `tau_user` is null or (reference.samples x n) row-major, kept likewise.
   // std::invalid_argument naming model, stiffness, a gain or reference on a size or sign error.
   KukaLikeController(const Model& model, const VectorIn& stiffness, const KukaLikeGains& gains,
-                     GravityCompensation gravity,
-                     const ReferenceTrajectory& reference, const double* tau_user = nullptr);
+                     GravityCompensation gravity, const ReferenceTrajectory& reference,
+                     const double* tau_user = nullptr);
   void command(int k, double t, const VectorIn& q, const VectorIn& qd, const VectorIn& theta,
                const VectorIn& thetad, const VectorIn& tau_J, VectorOut tau) override;
 

@@ -193,7 +193,8 @@ def _simulate_kuka_like(
     if not isinstance(model, ElasticRobot) or model.n != n:
         raise ValueError(
             f"model: expected the controller's dynid.ElasticRobot with {n} joints, got "
-            f"{type(model).__name__}" + (f" with {model.n}" if isinstance(model, ElasticRobot) else "")
+            f"{type(model).__name__}"
+            + (f" with {model.n}" if isinstance(model, ElasticRobot) else "")
         )
     if controller.gravity not in ("static", "desired"):
         raise ValueError(f"gravity: expected 'static' or 'desired', got {controller.gravity!r}")

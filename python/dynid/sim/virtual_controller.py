@@ -40,8 +40,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from typing import Union
-
 from .. import _checks as checks
 from .._checks import real_array
 from ..elastic import ElasticRobot
@@ -73,7 +71,7 @@ class TorqueRecording:
     q_desired: NDArray[np.float64]  #: (T, n) the commanded positions
     #: the closed-loop run (true q, qd, the commanded torques; an ElasticSimulation with theta,
     #: thetad, tau_J at the recording rate when the joints are elastic)
-    motion: Union[Simulation, ElasticSimulation]
+    motion: Simulation | ElasticSimulation
 
 
 #: Closed-loop bandwidth [rad/s] of the default position controller: each joint's PD gains put
@@ -278,7 +276,7 @@ class VirtualController:
         assert elastic is not None
         n, factor = elastic.n, TORQUE_LOOP_FACTOR
         dt = 1.0 / (rate * factor)
-        t_fine = np.arange(periods * factor + 1) * dt
+        t_fine = np.asarray(np.arange(periods * factor + 1) * dt, dtype=np.float64)
         q_d, qd_d, qdd_d = sample_reference(trajectory, t_fine, n, "trajectory")
         # The inertia the impedance law moves: the links' and the shaped motor's, B / (1 + K_T).
         inertia = np.diag(elastic.link.mass_matrix(q_d[0])) + elastic.B / (1.0 + self.torque_gain)
