@@ -11,7 +11,7 @@
 // With D_T = 0 the motor equation becomes B_theta thetadd + tau_J + B_theta B^-1 tau_F = u: the
 // torque loop scales the motor inertia (and its friction) down by 1 + K_T. tau_J' = K_c (thetad -
 // qd) with the controller's stiffness K_c. The position feedback is collocated (motor side), which
-// keeps the loop passive (Albu-Schaeffer 2007, Sect. 4; a link-side PD through the spring is not):
+// keeps the loop passive (Albu-Schaeffer 2007; a link-side PD through the spring is not):
 //   e = theta_d - theta,  ed = qd_d - thetad,  theta_d = q_d + K_c^-1 g_c(q_d),
 //   g_c = g_c(qbar(theta)) (static: qbar solves K_c (theta - qbar) = g_c(qbar)) or g_c(q_d)
 //   (desired: for a set-point this is the motor PD of MotorPDController), of the controller's
