@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.optimize
 
 import dynid
 from dynid.demo import controller_model, torque_validation
@@ -101,6 +102,35 @@ def test_user_torque_shifts_the_equilibrium_as_the_closed_form_says() -> None:
     np.testing.assert_allclose(run.theta[-1], theta, rtol=0, atol=1e-8)
     np.testing.assert_allclose(run.q[-1], q, rtol=0, atol=1e-8)
     np.testing.assert_allclose(run.tau_J[-1], elastic.link.gravity(q), rtol=0, atol=1e-6)
+
+
+def test_the_controller_uses_its_own_model() -> None:
+    """A controller whose model carries a 0.5 kg payload the plant does not have (gravity
+    "desired", K_T = 3, D_T = 1e-3 s) settles where the plant's link equation and the law
+    balance at rest, K (theta - q) = g_p(q) and Kp (q_d + K^-1 g_c(q_d) - theta) + g_c(q_d) =
+    K (theta - q), solved for q here with scipy's fsolve (residual < 1e-9 N m): q, theta within
+    1e-8 rad (measured 1e-14). The model's error moves the rest far more: |q - q_d| > 1e-3 rad
+    (measured 0.012)."""
+    robot = dynid.models.kuka_lwr4()
+    plant = lwr_elastic(robot)
+    heavier = robot.with_payload(0.5, (0.0, 0.0, 0.1), np.diag([1e-3, 1e-3, 5e-4]))
+    model = dynid.ElasticRobot(heavier, LWR_STIFFNESS, robot.Ia)
+    kp = np.linspace(300.0, 500.0, 7)
+    law = KukaLike(model, kp, 40.0, Q_D, torque_gain=3.0, torque_damping=1e-3, gravity="desired")
+    run = simulate_elastic(
+        plant, np.zeros(7), None, duration=10.0, controller=law, dt=1 / 3000, substeps=2
+    )
+    g_c = model.link.gravity(Q_D)
+
+    def rest(q):
+        theta = q + plant.link.gravity(q) / plant.K
+        return kp * (Q_D + g_c / plant.K - theta) + g_c - plant.link.gravity(q)
+
+    q = scipy.optimize.fsolve(rest, Q_D, xtol=1e-12)
+    assert np.abs(rest(q)).max() < 1e-9
+    np.testing.assert_allclose(run.q[-1], q, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(run.theta[-1], q + plant.link.gravity(q) / plant.K, atol=1e-8)
+    assert np.abs(run.q[-1] - Q_D).max() > 1e-3
 
 
 def test_without_torque_loop_it_is_the_motor_pd() -> None:
@@ -273,6 +303,14 @@ def test_elastic_recording_is_the_spring_torque_and_static_readings_are_unchange
         run.tau, elastic.K * (motion.theta - motion.q), rtol=0, atol=1e-12 * np.abs(run.tau).max()
     )
     assert run.q.shape == (201, 7) and np.array_equal(run.q, motion.q)
+    # encoder_counts quantises the recorded q (2 pi / counts) and nothing else
+    counts = 2.0**20
+    coarse = VirtualController(robot, elastic=elastic, encoder_counts=counts)
+    quantised = coarse.track(paper_motion, 0.2, 1000.0)
+    step = 2.0 * np.pi / counts
+    np.testing.assert_allclose(quantised.q / step, np.round(quantised.q / step), rtol=0, atol=1e-6)
+    assert np.abs(quantised.q - quantised.motion.q).max() <= 0.5 * step * (1 + 1e-9)
+    np.testing.assert_array_equal(quantised.tau, run.tau)
     q = np.random.default_rng(3).uniform(-1, 1, (5, 7))
     a = VirtualController(robot, model_noise=1e-3, seed=4).read_static(q)
     b = VirtualController(robot, model_noise=1e-3, seed=4, elastic=elastic).read_static(q)

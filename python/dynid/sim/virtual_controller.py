@@ -282,7 +282,9 @@ class VirtualController:
         inertia = np.diag(elastic.link.mass_matrix(q_d[0])) + elastic.B / (1.0 + self.torque_gain)
         kp, kd = self._gains(gains, inertia)
         if substeps is None:
-            substeps = elastic_substeps(elastic, q_d[0], dt, COULOMB_BAND, self.torque_gain, kd)
+            substeps = elastic_substeps(
+                elastic, q_d[0], dt, COULOMB_BAND, self.torque_gain, kd, self.torque_damping
+            )
         run = simulate_elastic(
             elastic,
             q_d[0],
@@ -381,11 +383,12 @@ def elastic_substeps(
     coulomb_band: float,
     torque_gain: ArrayLike = 0.0,
     kd: ArrayLike = 0.0,
+    torque_damping: ArrayLike = 0.0,
 ) -> int:
     """RK4 steps per control period dt of an elastic run under :class:`KukaLike`: the step
-    resolves the fastest spring oscillation (a :data:`SPRING_STEP` of its period) and the motor
-    damping near rest (friction band, Kd and the torque loop, on the shaped inertia
-    B / (1 + K_T); rate * h <= 2 as in :func:`stable_substeps`)."""
+    resolves the fastest spring oscillation (a :data:`SPRING_STEP` of its period, motors of the
+    shaped inertia B / (1 + K_T)) and the motor damping near rest (Kd through the torque loop,
+    the friction band, D_T K; rate * h <= 2 as in :func:`stable_substeps`)."""
     gain = 1.0 + np.asarray(torque_gain, dtype=float)
     # Undamped links and motors on the springs, shaped motor inertia: the largest frequency.
     n = elastic.n
@@ -398,9 +401,11 @@ def elastic_substeps(
     scaled = np.linalg.solve(L, np.linalg.solve(L, stiffness).T)  # L^-1 S L^-T
     omega = float(np.sqrt(max(np.linalg.eigvalsh(0.5 * (scaled + scaled.T))[-1], 0.0)))
     spring = dt * omega / (2.0 * np.pi * SPRING_STEP)
-    # Motor equation near rest: B_theta thetadd = -(Kd + B_theta B^-1 (Fv_m + Fs_m / band)) thetad.
+    # Motor equation near rest: B thetadd = -((1 + K_T) Kd + Fv_m + Fs_m / band + D_T K) thetad.
     friction = elastic.Fv_m + elastic.Fs_m / coulomb_band
-    motor = dt * float(np.max((np.asarray(kd, dtype=float) * gain + friction) / elastic.B)) / 2.0
+    damping = np.asarray(kd, dtype=float) * gain + friction
+    damping = damping + np.asarray(torque_damping, dtype=float) * elastic.K
+    motor = dt * float(np.max(damping / elastic.B)) / 2.0
     return max(1, int(np.ceil(max(spring, motor))))
 
 
