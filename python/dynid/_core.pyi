@@ -594,6 +594,13 @@ def _sincos(
     sin and cos of the flattened x by the vectorised sincos the kernels use (tests).
     """
 
+def _sos_filter(
+    sections: numpy.typing.ArrayLike, x: numpy.typing.ArrayLike, state: numpy.typing.ArrayLike
+) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    Filter the columns of x (T, C) through the second-order sections (S, 6) from the initial state (S, 2, C) (transposed direct form II, as scipy.signal.sosfilt with zi); returns (y, final state).
+    """
+
 def _supported_batch_isas() -> list:
     """
     The batch paths this CPU and build can run.
