@@ -503,6 +503,11 @@ def _last_batch_threads() -> int:
     Threads the last batch call ran on.
     """
 
+def _result_pool() -> tuple[int, int]:
+    """
+    (blocks, bytes) of large batch results' memory waiting for reuse (result_pool.hpp; tests).
+    """
+
 def _set_batch_isa(isa: str) -> None:
     """
     Force a batch path (for tests); also DYNID_BATCH_ISA at import. ValueError when the CPU cannot run it.
