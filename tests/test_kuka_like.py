@@ -338,6 +338,9 @@ def test_bad_arguments_name_the_argument() -> None:
         run(tau_user=np.zeros((3, 7)))
     with pytest.raises(ValueError, match=r"^reference"):
         run(reference=np.zeros(6))
+    soft = lwr_elastic(robot, stiffness=1.0)  # 1 N m/rad cannot hold the arm's gravity
+    with pytest.raises(RuntimeError, match=r"static link position .* did not converge"):
+        simulate_elastic(elastic, np.zeros(7), duration=0.01, controller=KukaLike(soft, 1, 1, Q_D))
     with pytest.raises(ValueError, match=r"^elastic:"):
         VirtualController(robot, elastic=robot)
     with pytest.raises(ValueError, match=r"^link_friction:"):

@@ -93,8 +93,7 @@ void KukaLikeController::command(int k, double, const VectorIn& q, const VectorI
   check_size(tau.size(), n, "tau");
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(k) * n;
   const ConstRow q_d(reference_.q + row, n), qd_d(reference_.qd + row, n);
-  // Outer law: u = Kp (theta_d - theta) + Kd (qd_d - thetad) + g_c, theta_d = q_d + K_c^-1
-  // g_c(q_d).
+  // Outer law: u = Kp (theta_d - theta) + Kd (qd_d - thetad) + g_c, theta_d = q_d + g_c / K_c.
   gravity(model_, ws_, q_d, g_desired_);
   u_ = gains_.kp.cwiseProduct(q_d + g_desired_.cwiseQuotient(stiffness_) - theta) +
        gains_.kd.cwiseProduct(qd_d - thetad);
