@@ -66,7 +66,7 @@ def identify(args: argparse.Namespace) -> None:
         log,
         robot,
         rotor=args.rotor,
-        friction=args.friction,
+        friction="asymmetric" if args.asymmetric_friction else args.friction,
         offset=args.offset,
         method=args.method,
         preparation=preparation_options(args),
