@@ -197,6 +197,34 @@ def test_with_offsets_the_offset_holds_the_coulomb_asymmetry(lwr):
     assert np.max(np.abs(result.predict(other) - other.tau)) <= 1e-9 * np.abs(other.tau).max()
 
 
+def test_asymmetric_friction_and_position_torque_are_told_apart_on_rich_motion(lwr):
+    """With a one-harmonic motion per joint |qd_j| is a function of q_j (docs/real_data.md),
+    so a viscous asymmetry can pass for a position torque; on the 3-harmonic logs both are
+    recovered together (noise-free, OLS): Fv+, Fv-, Fs, offsets and ks, kc to 1e-9 of the
+    largest base value. (Joint 2 has no position torque: there sin q2, cos q2 are gravity
+    columns, test_position_torque.py.)"""
+    ks, kc = np.linspace(0.3, -0.3, N), np.linspace(-0.2, 0.25, N)
+    ks[1] = kc[1] = 0.0
+    log = asymmetric_log(lwr, 1, offset=OFFSET)
+    tau = log.tau + ks * np.sin(log.q) + kc * np.cos(log.q)
+    result = identify_log(
+        Log(t=log.t, q=log.q, tau=tau, qd=log.qd, qdd=log.qdd),
+        lwr,
+        rotor=True,
+        friction="asymmetric",
+        offset=True,
+        position_torque=True,
+        method="ols",
+    )
+    joints = list(result.position_joints)
+    assert joints == [0, 2, 3, 4, 5, 6]
+    position = np.column_stack([ks[joints], kc[joints]]).reshape(-1)
+    halves = [FV_POS, FV_NEG, (FS_POS + FS_NEG) / 2, OFFSET + (FS_POS - FS_NEG) / 2]
+    truth = np.concatenate([*halves, position])
+    scale = np.abs(base_values(lwr)).max()
+    np.testing.assert_allclose(result.theta[result.count :], truth, rtol=0, atol=1e-9 * scale)
+
+
 def test_without_backward_motion_the_fit_names_the_unexcited_coefficients():
     arm = dynid.models.planar_2r()
     t = np.arange(0.0, 5.0, 0.01)

@@ -85,7 +85,8 @@ class LogIdentification(ValueEquality):
     :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
-    (``expressions`` gives each as a combination of the standard ones), then the offsets.
+    (``expressions`` gives each as a combination of the standard ones), then the asymmetric
+    friction coefficients, the offsets and the position torques, when asked for.
     ``independent`` and ``beta`` are those of :class:`dynid.BaseParameters` for the model's
     regressor columns ``parameter_names``. ``training`` holds the training log's source, size,
     preparation (options and notes, in words) and per-joint fit metrics.
@@ -98,7 +99,7 @@ class LogIdentification(ValueEquality):
     A physically consistent result (``identify_log(physical=True)``) has ``physical`` set (the
     solver's report: status, solver, times, prior, prior_weight, margin) and ``model`` holds the
     identified standard parameters and drive terms, so ``robot`` is the identified robot;
-    ``theta`` holds its base values (beta @ pi) and the offsets; ``std`` is inf and
+    ``theta`` holds its base values (beta @ pi) and the other coefficients; ``std`` is inf and
     ``covariance`` None (the constrained estimate has no least-squares covariance).
     """
 
@@ -226,7 +227,12 @@ class LogIdentification(ValueEquality):
             for k in ("rotor", "friction", "asymmetric_friction", "offset", "position_torque")
             if getattr(self, k)
         )
-        offsets = f" + {self.n} offsets" if self.offset else ""
+        offsets = ""
+        if self.asymmetric_friction:
+            offsets += (
+                f" + {asymmetric_count(self.n, self.offset)} asymmetric friction coefficients"
+            )
+        offsets += f" + {self.n} offsets" if self.offset else ""
         if self.position_joints:
             offsets += (
                 f" + position torque on joint(s) "
