@@ -328,21 +328,28 @@ def test_save_and_load_keep_the_asymmetric_friction(lwr, tmp_path):
 
 def test_momentum_observer_takes_the_asymmetric_friction_off(lwr):
     """The observer's robot (base values at the independent columns) plus ``extra_torque``
-    (asymmetric friction, offsets) is the identified prediction, to 1e-9 of the torques; its
-    residual on the exact model's own data equals, to 1e-9 of the torques, the residual of the
-    true robot run on the torques minus the true friction and offsets (computed here by their
-    definition): both are the observer's discretisation error only."""
+    (asymmetric friction, offsets, position torque) is the identified prediction, to 1e-9 of
+    the torques; its residual on the exact model's own data equals, to 1e-9 of the torques, the
+    residual of the true robot run on the torques minus the true friction, offsets and position
+    torque (computed here by their definition): both are the observer's discretisation error
+    only."""
     log = asymmetric_log(lwr, 1, offset=OFFSET)
-    result = identify_log(log, lwr, rotor=True, friction="asymmetric", offset=True)
+    position = 0.2 * np.sin(log.q) - 0.1 * np.cos(log.q)
+    position[:, 1] = 0.0  # joint 2: gravity columns (test_position_torque.py)
+    log = Log(t=log.t, q=log.q, tau=log.tau + position, qd=log.qd, qdd=log.qdd)
+    result = identify_log(
+        log, lwr, rotor=True, friction="asymmetric", offset=True, position_torque=True
+    )
     robot, offsets = robot_from_identification(result)
     np.testing.assert_array_equal(offsets, result.offsets)
+    np.testing.assert_allclose(offsets, OFFSET + (FS_POS - FS_NEG) / 2, rtol=0, atol=1e-9)
     predicted = result.predict(log)
     rebuilt = robot.rnea(log.q, log.qd, log.qdd) + result.extra_torque(log.q, log.qd)
     assert np.max(np.abs(rebuilt - predicted)) <= 1e-9 * np.abs(log.tau).max()
     exact = residual_from_log(result, log, 20.0)
     friction = friction_torque(log.qd, FV_POS, FV_NEG, FS_POS, FS_NEG)
-    truth = Log(t=log.t, q=log.q, tau=log.tau - friction - OFFSET, qd=log.qd, qdd=log.qdd)
-    reference = residual_from_log(lwr, truth, 20.0)
+    tau = log.tau - friction - OFFSET - position
+    reference = residual_from_log(lwr, Log(t=log.t, q=log.q, tau=tau, qd=log.qd), 20.0)
     assert np.max(np.abs(exact.r - reference.r)) <= 1e-9 * np.abs(log.tau).max()
     assert np.max(np.abs(reference.r)) > 1e-5  # a discretisation error to agree on
 
