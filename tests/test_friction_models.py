@@ -357,8 +357,8 @@ def test_momentum_observer_takes_the_asymmetric_friction_off(lwr):
 def test_cli_identify_and_validate_with_asymmetric_friction(lwr, tmp_path, capsys):
     """End to end: `dynid identify --asymmetric-friction --offset` writes the coefficients
     (Fv1+ ... and the offsets) that identify_log finds, `dynid validate` predicts another log
-    exactly (relative RMS < 1e-9); a log without backward motion of joint 1 is one line on
-    stderr and exit status 2."""
+    exactly (relative RMS < 1e-9); --friction with --asymmetric-friction, and a log without
+    backward motion, are one line on stderr and exit status 2."""
     model = tmp_path / "lwr.json"
     save_model(lwr, model)
     train, check = asymmetric_log(lwr, 1, offset=OFFSET), asymmetric_log(lwr, 4, offset=OFFSET)
@@ -379,6 +379,13 @@ def test_cli_identify_and_validate_with_asymmetric_friction(lwr, tmp_path, capsy
     report = json.loads((validation / "validation.json").read_text())
     assert max(report["metrics"]["relative_rms"]) < 1e-9
 
+    argv = ["identify", str(tmp_path / "train.npz"), "--model", str(model), "--friction"]
+    argv += ["--asymmetric-friction", "--output", str(tmp_path / "both")]
+    capsys.readouterr()
+    assert main(argv) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.count("\n") == 0 and "choose one friction model" in error
+
     forward = Log(t=train.t, q=train.q, tau=train.tau, qd=np.abs(train.qd), qdd=train.qdd)
     save_log(forward, tmp_path / "forward.npz")
     argv = ["identify", str(tmp_path / "forward.npz"), "--model", str(model)]
@@ -386,4 +393,5 @@ def test_cli_identify_and_validate_with_asymmetric_friction(lwr, tmp_path, capsy
     capsys.readouterr()
     assert main(argv) == 2
     error = capsys.readouterr().err.strip()
-    assert error.count("\n") == 0 and "Fv" in error and "-" in error
+    assert error.count("\n") == 0 and "14 unexcited direction(s)" in error  # Fv-, Fs- x 7
+    assert "least excited: Fv2-" in error

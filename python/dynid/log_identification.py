@@ -329,8 +329,8 @@ def identify_log(
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
         raise ValueError(f"physical: expected True or False, got {physical!r}")
-    model = friction_model(friction)
-    symmetric, asymmetric = model == "symmetric", model == "asymmetric"
+    kind = friction_model(friction)
+    symmetric, asymmetric = kind == "symmetric", kind == "asymmetric"
     if not isinstance(position_torque, (bool, np.bool_)):
         raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
     if not physical and (prior is not None or prior_weight is not None):

@@ -54,6 +54,8 @@ def identify(args: argparse.Namespace) -> None:
     check_output_path(args.output, args.overwrite)  # before the work, not after
     if not args.physical and (args.prior is not None or args.prior_weight is not None):
         raise ValueError("--prior, --prior-weight: only with --physical")
+    if args.friction and args.asymmetric_friction:
+        raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
     step(

@@ -51,6 +51,8 @@ UNITS = {
 }
 RESULT_FILE = "result.json"
 VALIDATION_FORMAT = "dynid-validation"
+#: Format version of validation.json (unchanged by the result's version 3).
+VALIDATION_VERSION = 2
 VALIDATION_FILE = "validation.json"
 
 
@@ -86,7 +88,7 @@ def save_validation(
     ``plots``, the torque and residual plots of the validation log; returns the JSON path."""
     report = {
         "format": VALIDATION_FORMAT,
-        "version": VERSION,
+        "version": VALIDATION_VERSION,
         "dynid_version": dynid_version(),
         "result": result_source,
         "log": log_source,
