@@ -2,9 +2,10 @@
 
 The symmetric model is the lecture's (Robotics 2, "Dynamic model with friction"; Gaz et al.,
 paper eq. (5)): tau_f,j = Fv_j qd_j + Fs_j sign(qd_j), columns of :meth:`dynid.Robot.regressor`
-(``friction=True``) and drive terms of the robot. The asymmetric model (FloBaRoID's
-"identifySymmetricVelFriction: 0" with its Coulomb terms; Swevers et al. 2007) lets each
-coefficient depend on the direction of motion:
+(``friction=True``) and drive terms of the robot. The asymmetric model lets each coefficient
+depend on the direction of motion; its viscous part is FloBaRoID's asymmetric viscous friction
+("identifySymmetricVelFriction: 0": Fv+ for qd > 0, Fv- for qd < 0, both >= 0 in its SDP), and
+the Coulomb level is split the same way:
 
     tau_f,j = Fv_j+ max(qd_j, 0) + Fv_j- min(qd_j, 0) + Fs_j+ [qd_j > 0] - Fs_j- [qd_j < 0]
 
