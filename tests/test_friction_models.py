@@ -396,3 +396,13 @@ def test_cli_identify_and_validate_with_asymmetric_friction(lwr, tmp_path, capsy
     error = capsys.readouterr().err.strip()
     assert error.count("\n") == 0 and "14 unexcited direction(s)" in error  # Fv-, Fs- x 7
     assert re.search(r"least excited: (F[vs]\d-, )+F[vs]\d- \(", error)
+
+
+def test_nonnegative_extra_argument_is_checked(lwr):
+    """physical_least_squares(nonnegative_extra=...): None or one boolean per extra column."""
+    log = fourier_log(lwr, 1, seconds=0.5)
+    Y = lwr.regressor(log.q, log.qd, log.qdd)
+    Y = np.concatenate([Y, np.ones((*Y.shape[:2], 2))], axis=2)
+    for bad in ([True], [1, 0], np.array([True, False, True]), "yes"):
+        with pytest.raises(ValueError, match=r"^nonnegative_extra: expected None or 2 booleans"):
+            dynid.physical_least_squares(lwr, Y, log.tau, extra_columns=2, nonnegative_extra=bad)
