@@ -96,7 +96,7 @@ class PhysicalResult(ValueEquality):
     Ia: NDArray[np.float64] | None  #: (n,) when rotor=True
     Fv: NDArray[np.float64] | None  #: (n,) when friction=True
     Fs: NDArray[np.float64] | None  #: (n,) when friction=True
-    extra: NDArray[np.float64]  #: (extra_columns,) the unconstrained coefficients
+    extra: NDArray[np.float64]  #: (extra_columns,) the coefficients of the extra columns
     theta: NDArray[np.float64]  #: (P + extra_columns,) the whole estimate, Y @ theta predicts tau
     base_values: NDArray[np.float64]  #: base.beta @ pi (p,), base of the torque regressor
     base_names: list[str]
@@ -159,7 +159,8 @@ def physical_least_squares(
     margin
         J_i - margin I_4 positive semidefinite (see :data:`DEFAULT_MARGIN`), > 0.
     extra_columns
-        Number of trailing columns of Y with unconstrained coefficients (e.g. torque offsets).
+        Number of trailing columns of Y whose coefficients are not standard parameters (e.g.
+        torque offsets): unconstrained, except those marked in ``nonnegative_extra``.
     nonnegative_extra
         None, or (extra_columns,) booleans: the extra coefficients constrained >= 0 (e.g. the
         asymmetric friction coefficients Fv+, Fv-, Fs+, Fs- of
