@@ -115,6 +115,10 @@ class LogIdentification(ValueEquality):
     physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
     #: joints (0-based) with a position torque ks_j sin q_j + kc_j cos q_j (``position_torque``)
     position_joints: tuple[int, ...] = ()
+    #: identified from motor currents (``dynid.identify_drive_gains``): the drive gains k
+    #: ("gains", "gains_std", tau = k * current), the payload that fixed their scale and the
+    #: runs; JSON-ready
+    drive_gains: dict[str, Any] | None = None
     #: the prepared training log (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
     _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
