@@ -54,7 +54,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from ._core import standard_parameters
+from ._core import physical_inconsistency, standard_parameters
 from ._equality import ValueEquality
 from ._qr import GroupedTriangularFactors
 from .base_parameters import base_parameters
@@ -431,7 +431,11 @@ def _payload(
                 f"payload: expected com (3,) and inertia (3, 3), got {com.shape} and "
                 f"{inertia.shape}"
             )
+        why = physical_inconsistency(float(m), inertia)
+        if why:
+            raise ValueError(f"payload.inertia: the payload is not physically possible: {why}")
         return np.asarray(standard_parameters(float(m), com, inertia), dtype=float), []
+    assert payload is not None  # exactly one of payload, mass was given
     known = checks.real_array(payload, "payload")
     if known.shape != (10,):
         raise ValueError(
