@@ -203,6 +203,9 @@ class LogIdentification(ValueEquality):
             f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}"
         )
         head = [model, fit]
+        if self.drive_gains is not None:  # identified from motor currents
+            gains = ", ".join(f"{k:.6g}" for k in self.drive_gains.get("gains", []))
+            head.append(f"drive gains k (tau = k * current): {gains}")
         if self.physical is not None:
             report = self.physical
             prior = (
