@@ -50,15 +50,19 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Union
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks as checks
-from ._core import physical_inconsistency, standard_parameters
 from ._equality import ValueEquality
 from ._qr import GroupedTriangularFactors
 from .base_parameters import base_parameters
-from .identify import VARIANCE_FLOOR, RankDeficientError, relative_std, solve_factors
+from .drive_gain_system import (
+    current_least_squares,
+    payload_vector,
+    total_least_squares,
+    visible_payload,
+)
+from .identify import RankDeficientError, relative_std, solve_factors
 from .io.log_files import Log
 from .io.model_files import model_to_dict
 from .io.preparation import prepare_log
@@ -77,10 +81,6 @@ from .validation import error_metrics
 METHODS = ("nls", "tls", "wls", "ols")
 #: Name of the drive gain of joint j (1-based) among the unknowns: "k1", "k2", ...
 GAIN_NAME = "k"
-#: "nls": the largest relative change of a gain from the TLS start accepted (a doubled gain or a
-#: flipped sign); beyond it the fit is drifting towards an infinite scale (a model that misses a
-#: term: gains of 1e9 and more). The two estimates differ by < 40 % with 2 % current noise.
-DRIFT_LIMIT = 1.0
 #: Rank tolerance of the stacked system (that of dynid.least_squares).
 RANK_TOLERANCE = 1e-10
 
@@ -194,11 +194,11 @@ def identify_drive_gains(
     options = _options(preparation)
     runs = [(False, log) for log in _runs(unloaded, "unloaded", n, options)]
     runs += [(True, log) for log in _runs(loaded, "loaded", n, options)]
-    known, estimated = _payload(payload, payload_mass)
+    known, estimated = payload_vector(payload, payload_mass)
     base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
     last = np.arange(10 * (n - 1), 10 * n)
     if estimated:
-        estimated = _visible_payload(base.beta[:, last])
+        estimated = visible_payload(base.beta[:, last])
     names = list(base.names) + ([f"{OFFSET_NAME}{j}" for j in range(1, n + 1)] if offset else [])
     expressions = list(base.expressions)
     expressions += [f"torque offset of joint {j}" for j in range(1, n + 1)] if offset else []
@@ -262,9 +262,9 @@ def identify_drive_gains(
             "payload, a longer or richer loaded trajectory)."
         ) from None
     if method in ("tls", "nls"):  # the LS fit above checked the rank
-        x, covariance = _total_least_squares(factors)
+        x, covariance = total_least_squares(factors)
         if method == "nls":
-            x, covariance = _current_least_squares(factors, x, p)
+            x, covariance = current_least_squares(factors, x, p)
     else:
         x, covariance = fit.theta, fit.covariance
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
@@ -400,187 +400,6 @@ def _runs(value: Any, name: str, n: int, options: Mapping[str, Any]) -> list[Log
 
 def _arrays(value: tuple) -> bool:
     return all(np.ndim(a) == 2 for a in value)
-
-
-def _payload(
-    payload: ArrayLike | Mapping[str, Any] | None, mass: float | None
-) -> tuple[NDArray[np.float64], list[int]]:
-    """The known part of pi_L (10,) and the indices of its estimated entries."""
-    if (payload is None) == (mass is None):
-        raise ValueError(
-            "payload, payload_mass: give exactly one: the payload's 10 parameters (or mass, com, "
-            "inertia) or its mass alone; without either the scale of (theta, k) is undetermined"
-        )
-    if mass is not None:
-        value = checks.real_array(mass, "payload_mass")
-        if value.ndim != 0 or not value > 0:
-            raise ValueError(f"payload_mass: expected a positive mass in kg, got {mass!r}")
-        known = np.zeros(10)
-        known[0] = float(value)
-        return known, list(range(1, 10))
-    if isinstance(payload, Mapping):
-        unknown = sorted(set(payload) - {"mass", "com", "inertia"})
-        if unknown or "mass" not in payload or "com" not in payload:
-            raise ValueError(
-                "payload: expected a mapping with mass, com and optionally inertia (about the "
-                f"centre of mass, frame n), got the keys {sorted(payload)}"
-            )
-        m = checks.real_array(payload["mass"], "payload.mass")
-        if m.ndim != 0 or not m > 0:
-            raise ValueError(f"payload.mass: expected a positive mass, got {payload['mass']!r}")
-        com = checks.real_array(payload["com"], "payload.com")
-        inertia = checks.real_array(payload.get("inertia", np.zeros((3, 3))), "payload.inertia")
-        if com.shape != (3,) or inertia.shape != (3, 3):
-            raise ValueError(
-                f"payload: expected com (3,) and inertia (3, 3), got {com.shape} and "
-                f"{inertia.shape}"
-            )
-        why = physical_inconsistency(float(m), inertia)
-        if why:
-            raise ValueError(f"payload.inertia: the payload is not physically possible: {why}")
-        return np.asarray(standard_parameters(float(m), com, inertia), dtype=float), []
-    assert payload is not None  # exactly one of payload, mass was given
-    known = checks.real_array(payload, "payload")
-    if known.shape != (10,):
-        raise ValueError(
-            f"payload: expected the 10 standard parameters (m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, "
-            f"Iyz, Izz) in frame n, got shape {known.shape}"
-        )
-    if not known[0] > 0:
-        raise ValueError(f"payload: expected a positive mass (first entry), got {known[0]!r}")
-    return known.copy(), []
-
-
-def _visible_payload(beta_n: NDArray[np.float64]) -> list[int]:
-    """Among the payload's first moments and inertia (columns 1..9 of beta's last-link block),
-    those the base parameters tell apart, greedily left to right (as base_parameters picks its
-    columns); ValueError when the mass is not distinguishable from them."""
-    scale = np.linalg.norm(beta_n, axis=0)
-    scale[scale == 0] = 1.0
-    B = beta_n / scale
-    kept: list[int] = []
-    for c in range(1, 10):
-        if _rank(B[:, [*kept, c]]) > len(kept):
-            kept.append(c)
-    if _rank(B[:, [0, *kept]]) <= len(kept):
-        raise ValueError(
-            "payload_mass: on this structure the payload's mass acts on the joint torques only "
-            "through combinations its other parameters also enter, so a known mass cannot fix "
-            "the scale; give the whole payload (payload=...)"
-        )
-    return kept
-
-
-def _rank(M: NDArray[np.float64]) -> int:
-    s = scipy.linalg.svdvals(M)
-    return int(np.count_nonzero(s > 1e-10 * max(s[0], 1.0))) if s.size else 0
-
-
-def _total_least_squares(
-    factors: GroupedTriangularFactors,
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """TLS of the stacked [A | b] from its triangular factor (the same right singular vectors),
-    rows unweighted as in FIGAROH, columns scaled to unit norm (units do not matter). Returns x
-    and the first-order covariance of an unweighted fit with per-joint noise sigma_j (from the
-    TLS residuals): G^-1 (sum_j sigma_j^2 A_j^T A_j) G^-1, G = A^T A."""
-    p = factors.p
-    x = _tls_solution(factors.combined())
-    shift = (factors.b_exp or 0) - (factors.a_exp or 0)  # back from the factors' units
-    Rs = [R[:, :p] for R in factors.factors.values()]
-    rows = factors.rows
-    variance = factors.residual_squares(x) / (factors.samples * (rows - p) / rows)
-    scale = np.sqrt(sum(np.sum(R**2, axis=0) for R in Rs))
-    scale[scale == 0] = 1.0
-    G = sum((R / scale).T @ (R / scale) for R in Rs)
-    H = sum(v * (R / scale).T @ (R / scale) for v, R in zip(variance, Rs))
-    inverse = np.linalg.pinv(G, hermitian=True)
-    covariance = (inverse @ H @ inverse) / np.outer(scale, scale)
-    return np.ldexp(x, shift), np.ldexp(covariance, 2 * shift)
-
-
-def _current_least_squares(
-    factors: GroupedTriangularFactors, start: NDArray[np.float64], p: int
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Weighted nonlinear least squares on the currents, from ``start`` (the TLS solution).
-
-    Joint j's equations Y theta - i k_j = d, divided by k_j, are i = (Y theta - d) / k_j: the
-    measured current as the output, so white current noise e_j is the residual and minimising
-    sum_j ||A_j x - b_j||^2 / (s_j k_j)^2 is maximum likelihood (s_j the current noise, from the
-    residuals, re-estimated twice). Each joint's term is ||R_j [x; -1]||^2 / (s_j k_j)^2 with R_j
-    its triangular factor, so the fit never returns to the samples. The covariance is the
-    Gauss-Newton (J^T J)^-1 at the solution."""
-    from scipy.optimize import least_squares as nonlinear_least_squares
-
-    shift = (factors.b_exp or 0) - (factors.a_exp or 0)
-    x = np.ldexp(start, -shift)  # the factors' units
-    Rs = list(factors.factors.values())
-    gain = [p + j for j in factors.joints]
-    if not np.any(factors.residual_squares(x) > 0):  # noise-free: TLS is exact already
-        return start, np.zeros((x.size, x.size))
-    rows = factors.rows
-    dof = factors.samples * (rows - x.size) / rows
-
-    def noise(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        squares = np.array([np.sum((R @ np.append(x, -1.0)) ** 2) for R in Rs])
-        s = np.sqrt(squares / dof) / np.abs(x[gain])
-        return np.maximum(s, np.sqrt(VARIANCE_FLOOR) * s.max())
-
-    def residual(x: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.concatenate(
-            [R @ np.append(x, -1.0) / (sj * x[g]) for R, sj, g in zip(Rs, s, gain)]
-        )
-
-    def jacobian(x: NDArray[np.float64], s: NDArray[np.float64]) -> NDArray[np.float64]:
-        blocks = []
-        for R, sj, g in zip(Rs, s, gain):
-            r = R @ np.append(x, -1.0)
-            block = R[:, :-1] / (sj * x[g])
-            block[:, g] -= r / (sj * x[g] ** 2)
-            blocks.append(block)
-        return np.vstack(blocks)
-
-    for _ in range(3):
-        s = noise(x)
-        x = nonlinear_least_squares(
-            residual,
-            x,
-            jac=jacobian,
-            args=(s,),
-            method="lm",
-            x_scale="jac",
-            xtol=1e-15,
-            ftol=1e-15,
-            gtol=1e-15,
-        ).x
-    drift = np.abs(x[gain] / np.ldexp(start[gain], -shift) - 1.0)
-    if not (np.all(np.isfinite(x)) and drift.max() < DRIFT_LIMIT):
-        # The likelihood keeps rising towards an infinite common scale, where the payload's
-        # rows stop mattering: they do not explain the data (a missing column, a wrong payload).
-        raise RankDeficientError(
-            "the currents do not fix the scale: the nonlinear fit drifts away from the TLS "
-            f"solution (gains changed by up to {100 * drift.max():.3g} %), so the payload's "
-            "torques are not what the loaded run shows; check the payload and the model's "
-            "columns (rotor, friction, offset)"
-        )
-    J = jacobian(x, noise(x))
-    _, sv, Vt = np.linalg.svd(J, full_matrices=False)
-    covariance = (Vt.T / sv**2) @ Vt
-    return np.ldexp(x, shift), np.ldexp(covariance, 2 * shift)
-
-
-def _tls_solution(R: NDArray[np.float64]) -> NDArray[np.float64]:
-    """x = -v[:-1] / v[-1], v the right singular vector of the smallest singular value of R
-    (the R of [A | b]) with unit-norm columns."""
-    scale = np.linalg.norm(R, axis=0)
-    scale[scale == 0] = 1.0
-    _, _, Vt = scipy.linalg.svd(R / scale, lapack_driver="gesvd")
-    v = Vt[-1] / scale
-    if abs(v[-1]) <= 1e-12 * np.abs(v).max():
-        raise RankDeficientError(
-            "method: the total least-squares problem has no solution (the smallest singular "
-            "vector of [A | b] does not involve the payload column): use method='wls'"
-        )
-    return -v[:-1] / v[-1]
 
 
 def _converted(gains: NDArray[np.float64]) -> str:
