@@ -249,7 +249,7 @@ def identify_drive_gains(
     try:
         fit = solve_factors(
             factors,
-            method="wls" if method == "wls" else "ols",
+            method="ols" if method == "ols" else "wls",  # WLS: a start for "nls"
             names=unknowns,
             on_rank_deficient="raise",
             rank_tolerance=RANK_TOLERANCE,
@@ -264,7 +264,7 @@ def identify_drive_gains(
     if method in ("tls", "nls"):  # the LS fit above checked the rank
         x, covariance = total_least_squares(factors)
         if method == "nls":
-            x, covariance = current_least_squares(factors, x, p)
+            x, covariance = current_least_squares(factors, [fit.theta, x], p)
     else:
         x, covariance = fit.theta, fit.covariance
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
