@@ -24,15 +24,15 @@ Three solvers, all on the triangular factors of the stacked [A | b] (chunk by ch
   k_j reads i_j = (Y_j theta - d_j) / k_j: the measured current is the output, so white current
   noise is the residual and the weighted fit (weights 1/s_j, the current noise of joint j from
   the residuals) is maximum likelihood, consistent, with the Gauss-Newton covariance as its
-  standard deviations. Started from the TLS solution; each joint's term
-  ||A_j x - b_j||^2 / (s_j k_j)^2 = ||R_j [x; -1]||^2 / (s_j k_j)^2 needs only its R_j.
+  standard deviations. Started from the WLS solution (then from TLS's if that fails); each
+  joint's term ||A_j x - b_j||^2 / (s_j k_j)^2 = ||R_j [x; -1]||^2 / (s_j k_j)^2 needs only R_j.
 - ``"tls"``: total least squares as in Gautier & Briot and FIGAROH: x = -v[:-1] / v[-1], v the
   right singular vector of the smallest singular value of [A | b] (rows unweighted as in FIGAROH,
   columns scaled to unit norm so that the units do not matter). It copes with the noise in the
   gain columns -diag(i) far better than least squares, but assumes equal noise in every column
   where only the current columns have any, so it keeps a bias of about one standard deviation
-  (tests/test_drive_gains.py); the standard deviations are first order (those of an unweighted
-  fit with each joint's noise).
+  at 2 % current noise and breaks down at 5 % (gains of the wrong sign; docs/drive_gains.md);
+  the standard deviations are first order (those of an unweighted fit with each joint's noise).
 - ``"wls"`` / ``"ols"``: least squares on the inhomogeneous system (``dynid.least_squares``,
   its rank check and standard deviations). The current noise sits in the gain columns, and
   shrinking the common scale of (theta, k) shrinks that noise's share of the residual, which
