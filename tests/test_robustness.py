@@ -162,6 +162,23 @@ def test_write_text_atomic(tmp_path) -> None:
     assert [p.name for p in tmp_path.iterdir()] == ["x.txt"]
 
 
+def test_results_get_the_permissions_of_new_files(tmp_path) -> None:
+    """The staging folder and the atomic file are created private (mkstemp's 0o600); what is
+    left in place has the permissions any new folder or file gets under the umask."""
+    import os
+    import stat
+
+    previous = os.umask(0o022)
+    try:
+        with output_folder(tmp_path / "run") as staging:
+            (staging / "a.json").write_text("{}")
+        write_text_atomic(tmp_path / "x.txt", "one")
+    finally:
+        os.umask(previous)
+    assert stat.S_IMODE((tmp_path / "run").stat().st_mode) == 0o755
+    assert stat.S_IMODE((tmp_path / "x.txt").stat().st_mode) == 0o644
+
+
 # --------------------------------------------------------------------------- item 13
 
 

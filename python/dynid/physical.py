@@ -49,6 +49,7 @@ from . import _checks as checks
 from ._checks import positive
 from ._equality import ValueEquality
 from .base_parameters import base_parameters
+from .errors import PhysicalIdentificationError
 from .physical_arguments import (
     check_data,
     check_mass_bounds,
@@ -81,15 +82,6 @@ PROJECTION_TOLERANCE = 1e-6
 #: not enough for the noise-free recovery this module promises, and a silent switch to a less
 #: accurate solver would hide a failure instead of reporting it.
 SOLVER = "CLARABEL"
-
-
-class PhysicalIdentificationError(RuntimeError):
-    """The semidefinite programme was not solved to optimality (``status`` says how it ended:
-    e.g. "infeasible" when the mass bounds contradict the total mass)."""
-
-    def __init__(self, message: str, status: str) -> None:
-        super().__init__(message)
-        self.status = status
 
 
 @dataclass(eq=False)

@@ -41,7 +41,13 @@ def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
 def demo(args: argparse.Namespace) -> None:
     from ..demo import run_demo
 
-    run_demo(args.output, train=args.train, validation=args.validation, seed=args.seed)
+    run_demo(
+        args.output,
+        train=args.train,
+        validation=args.validation,
+        seed=args.seed,
+        overwrite=args.overwrite,
+    )
 
 
 def identify(args: argparse.Namespace) -> None:

@@ -20,7 +20,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo = subcommands.add_parser(
         "demo", help="the KUKA LWR-IV identification of Gaz et al. (ICRA 2014) on a simulated arm"
     )
-    demo.add_argument("--output", default="dynid-demo", help="output folder (default ./dynid-demo)")
+    _add_output(demo, "dynid-demo")
     demo.add_argument("--train", type=int, default=1000, help="training configurations")
     demo.add_argument("--validation", type=int, default=200, help="validation configurations")
     demo.add_argument("--seed", type=int, default=0)
