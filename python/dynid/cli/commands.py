@@ -67,6 +67,8 @@ def identify(args: argparse.Namespace) -> None:
         raise ValueError(f"--method {args.method}: only with --current (motor currents)")
     if not args.physical and (args.prior is not None or args.prior_weight is not None):
         raise ValueError("--prior, --prior-weight: only with --physical")
+    if args.friction and args.asymmetric_friction:
+        raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
     step(
@@ -79,7 +81,7 @@ def identify(args: argparse.Namespace) -> None:
         log,
         robot,
         rotor=args.rotor,
-        friction=args.friction,
+        friction="asymmetric" if args.asymmetric_friction else args.friction,
         offset=args.offset,
         method=args.method or "wls",
         preparation=preparation_options(args),

@@ -50,6 +50,13 @@ def _add_identify(subcommands: Any) -> None:
         "--friction", action="store_true", help="add viscous and Coulomb friction columns Fv, Fs"
     )
     p.add_argument(
+        "--asymmetric-friction",
+        action="store_true",
+        help="friction with one coefficient per direction of motion, Fv+, Fv-, Fs+, Fs- "
+        "(with --offset: Fv+, Fv-, Fs, the offset holding the Coulomb asymmetry), instead of "
+        "--friction's Fv, Fs (docs/identification.md)",
+    )
+    p.add_argument(
         "--offset", action="store_true", help="add a constant torque (sensor offset) per joint"
     )
     p.add_argument(
