@@ -343,6 +343,7 @@ def test_cli_identify_current_and_validate(files, tmp_path, capsys, lwr, known):
         (["--payload-mass", "1"], "--payload-log, --payload, --payload-mass: only with --current"),
         (["--method", "tls"], "--method tls: only with --current"),
         (["--current", "--physical"], "--current: not with --physical"),
+        (["--current", "--asymmetric-friction"], "--current: not with --physical"),
         (["--current", "--payload-log", "L", "--payload", "1,2"], "neither a file nor 10"),
     ],
 )

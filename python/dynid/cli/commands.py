@@ -106,8 +106,10 @@ def identify_from_currents(args: argparse.Namespace) -> None:
     from ..io.payload_files import load_payload
     from ..io.result_files import save_result
 
-    if args.physical or args.position_torque or args.prior is not None:
-        raise ValueError("--current: not with --physical, --prior or --position-torque")
+    if args.physical or args.position_torque or args.prior is not None or args.asymmetric_friction:
+        raise ValueError(
+            "--current: not with --physical, --prior, --position-torque or --asymmetric-friction"
+        )
     if args.payload_log is None:
         raise ValueError(
             "--current: needs --payload-log LOG, a run with a known payload: currents fix the "
