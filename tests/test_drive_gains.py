@@ -218,6 +218,23 @@ def test_a_loaded_run_without_the_payload_effect_is_rank_deficient(lwr, runs):
         identify_drive_gains(lwr, unloaded, check, payload=PAYLOAD, rotor=True, friction=True)
 
 
+def test_a_payload_too_light_for_the_noise_is_an_error(lwr):
+    """10 g at the flange against 2 % current noise (5 s runs): the likelihood has no finite
+    optimum along the scale; 50 g is enough (gains within 4 std, relative std ~5 %)."""
+    for mass, enough in ((0.01, False), (0.05, True)):
+        arm = lwr.with_payload(mass, COM, None)
+        train, loaded = fourier_log(lwr, 1), fourier_log(lwr, 2)
+        u = current_log(train, lwr.rnea(train.q, train.qd, train.qdd), 0.02, 0)
+        ell = current_log(loaded, arm.rnea(loaded.q, loaded.qd, loaded.qdd), 0.02, 1)
+        kwargs = {"payload": {"mass": mass, "com": COM}, "rotor": True, "friction": True}
+        if enough:
+            fit = identify_drive_gains(lwr, u, ell, **kwargs)
+            assert np.all(np.abs(fit.gains - K_TRUE) < 4 * fit.gains_std)
+        else:
+            with pytest.raises(RankDeficientError, match="too small against the noise"):
+                identify_drive_gains(lwr, u, ell, **kwargs)
+
+
 def test_a_mass_the_structure_cannot_see_is_an_error():
     """One joint about the vertical: the link's mass enters no torque, nor the payload's."""
     arm = dynid.Robot.from_dh([[0.5, 0.0, 0.0, 0.0]], joint_types="R")
@@ -277,6 +294,17 @@ def test_saved_result_keeps_the_gains_and_validates_a_current_log(lwr, runs, tmp
     plain = dynid.identify_log(torques, lwr)
     with pytest.raises(ValueError, match="result: holds no drive gains"):
         torques_from_currents(plain, check)
+
+
+def test_a_point_mass_payload_is_its_standard_parameters():
+    """mass and com without inertia: a point mass (Steiner in the tests' reference model)."""
+    from dynid.drive_gain_system import payload_vector
+
+    known, estimated = payload_vector({"mass": 2.0, "com": COM}, None)
+    np.testing.assert_allclose(
+        known, physical_to_params(2.0, COM, np.zeros((3, 3))), rtol=0, atol=1e-15
+    )
+    assert estimated == []
 
 
 def test_payload_specs(tmp_path):

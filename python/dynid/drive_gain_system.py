@@ -68,8 +68,8 @@ def payload_vector(
                 f"payload: expected com (3,) and inertia (3, 3), got {com.shape} and "
                 f"{inertia.shape}"
             )
-        why = physical_inconsistency(float(m), inertia)
-        if why:
+        why = physical_inconsistency(float(m), inertia) if "inertia" in payload else ""
+        if why:  # (a point mass, without inertia, is possible)
             raise ValueError(f"payload.inertia: the payload is not physically possible: {why}")
         return np.asarray(standard_parameters(float(m), com, inertia), dtype=float), []
     assert payload is not None  # exactly one of payload, mass was given
@@ -208,9 +208,10 @@ def current_least_squares(
         # too much noise for what the payload shows).
         raise RankDeficientError(
             "the currents do not fix the scale: the nonlinear fit does not converge from its "
-            "WLS and TLS starts (it runs towards an infinite scale), so the payload's torques "
-            "are not what the loaded run shows; check the payload and the model's columns "
-            "(rotor, friction, offset), or record more (or richer) loaded motion"
+            "WLS and TLS starts (it runs towards an infinite scale): the payload's torques are "
+            "too small against the noise, or not what the loaded run shows; use a heavier "
+            "payload or more (richer) loaded motion, check the payload and the model's columns "
+            "(rotor, friction, offset)"
         )
     flipped = [j + 1 for j, g in zip(factors.joints, gain) if best[g] * starts[0][g] < 0]
     if flipped:
