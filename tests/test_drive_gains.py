@@ -361,6 +361,10 @@ def test_cli_identify_current_and_validate(files, tmp_path, capsys, lwr, known):
     assert main(argv) == 0
     report = json.loads((check / "validation.json").read_text())
     assert max(report["metrics"]["relative_rms"]) < 1e-8
+    capsys.readouterr()
+    argv = ["validate", str(out), str(files / "check.csv"), "--output", str(tmp_path / "raw")]
+    assert main(argv) == 0  # currents compared as torques: allowed, with a note
+    assert "note: the result was identified from motor currents" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(
