@@ -205,6 +205,27 @@ void bind_model(py::module_& m) {
             self.modify([&](Model& model) { model.set_coulomb_friction(Fs); });
           },
           "Coulomb friction coefficients (n,).")
+      .def_property(
+          "transmission",
+          [](const PyModel& self) {
+            const RowMajorMatrixX T = self.model->transmission();
+            return read_only(T.data(), {self.model->n(), self.model->n()});
+          },
+          [](PyModel& self, py::handle value) {
+            const int n = self.model->n();
+            MatrixX T = MatrixX::Identity(n, n);
+            if (!value.is_none()) {
+              Array a = parse_fixed(value, "transmission", {n, n});
+              T = Eigen::Map<const RowMajorMatrixX>(a.data(), n, n);
+            }
+            // std::invalid_argument (shape, NaN, singular) reaches Python as a ValueError.
+            self.modify([&](Model& model) { model.set_transmission(T); });
+          },
+          "Transmission coupling T (n, n): motor velocities (after the gears) theta_dot = T qd "
+          "(notes p. 11-13). Identity (set None) is the decoupled model; otherwise Ia, Fv, Fs are "
+          "per motor and the drive torque is T^T (Ia T qdd + Fv T qd + Fs sign(T qd)). "
+          "ValueError naming transmission unless T is finite and invertible "
+          "(sigma_min / sigma_max > 1e-12).")
       .def(
           "_set_link_physical",
           [](PyModel& self, int i, double mass, py::handle com, py::handle inertia_com) {
