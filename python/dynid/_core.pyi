@@ -339,6 +339,13 @@ class Model:
         """
     @tool.setter
     def tool(self, arg1: numpy.typing.ArrayLike) -> None: ...
+    @property
+    def transmission(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Transmission coupling T (n, n): motor velocities (after the gears) theta_dot = T qd (notes p. 11-13). Identity (set None) is the decoupled model; otherwise Ia, Fv, Fs are per motor and the drive torque is T^T (Ia T qdd + Fv T qd + Fs sign(T qd)). ValueError naming transmission unless T is finite and invertible (sigma_min / sigma_max > 1e-12).
+        """
+    @transmission.setter
+    def transmission(self, arg1: numpy.typing.ArrayLike | None) -> None: ...
 
 class MomentumObserver:
     """
