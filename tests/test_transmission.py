@@ -84,7 +84,11 @@ def test_diagonal_transmission_is_the_decoupled_robot_with_scaled_drives(case, r
     coupled.transmission = np.diag(t)
     decoupled = coupled.copy()
     decoupled.transmission = None
-    decoupled.Ia, decoupled.Fv, decoupled.Fs = coupled.Ia * t**2, coupled.Fv * t**2, coupled.Fs * abs(t)
+    decoupled.Ia, decoupled.Fv, decoupled.Fs = (
+        coupled.Ia * t**2,
+        coupled.Fv * t**2,
+        coupled.Fs * abs(t),
+    )
     for _ in range(3):
         q, qd, qdd = random_state(rng, arm)  # qd away from 0 (Coulomb)
         qddd, qdddd = rng.normal(size=(2, n))
@@ -288,10 +292,16 @@ def test_puma_rnea_derivatives_match_finite_differences(rng) -> None:
     dq, dqd = robot.rnea_derivatives(q, qd, qdd)
     h = 1e-6
     fd_q = np.array(
-        [(robot.rnea(q + h * e, qd, qdd) - robot.rnea(q - h * e, qd, qdd)) / (2 * h) for e in np.eye(6)]
+        [
+            (robot.rnea(q + h * e, qd, qdd) - robot.rnea(q - h * e, qd, qdd)) / (2 * h)
+            for e in np.eye(6)
+        ]
     ).T
     fd_qd = np.array(
-        [(robot.rnea(q, qd + h * e, qdd) - robot.rnea(q, qd - h * e, qdd)) / (2 * h) for e in np.eye(6)]
+        [
+            (robot.rnea(q, qd + h * e, qdd) - robot.rnea(q, qd - h * e, qdd)) / (2 * h)
+            for e in np.eye(6)
+        ]
     ).T
     assert_close(dq, fd_q, 1e-7)
     assert_close(dqd, fd_qd, 1e-7)

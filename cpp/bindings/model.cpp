@@ -258,14 +258,16 @@ void bind_model(py::module_& m) {
       [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, ConstVec qdd, double* tau) {
         rnea(m, ws, q, qd, qdd, OutVec(tau, m.n()));
       },
-      "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).",
+      "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler); with a "
+      "transmission T the friction is T^T (Fv T qd + Fs sign(T qd)).",
       &detail::LaneKernels::rnea);
   def_per_sample(
       model, "mass_matrix", {"q"}, joint_by_joint,
       [](const Model& m, Workspace& ws, ConstVec q, double* M) {
         crba(m, ws, q, row_major(M, m.n(), m.n()));
       },
-      "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).",
+      "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA); T^T diag(Ia) T with a "
+      "transmission T.",
       &detail::LaneKernels::mass_matrix);
   def_per_sample(
       model, "gravity", {"q"}, per_joint,
@@ -291,7 +293,7 @@ void bind_model(py::module_& m) {
       [](const Model& m, Workspace&, ConstVec qd, double* tau) {
         friction(m, qd, OutVec(tau, m.n()));
       },
-      "Joint friction Fv qd + Fs sign(qd).");
+      "Joint friction Fv qd + Fs sign(qd); T^T (Fv T qd + Fs sign(T qd)) with a transmission T.");
   // M(q) not positive definite (a std::domain_error) is a ValueError about the parameters.
   def_per_sample<DomainError::Params>(
       model, "forward_dynamics", {"q", "qd", "tau"}, per_joint,

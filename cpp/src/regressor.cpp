@@ -250,7 +250,8 @@ void inertia_regressor(const Model& model, Workspace& workspace, const VectorIn&
         continue;
       }
       for (int k = 1; k <= i; ++k)
-        for (int m = 0; m < n; ++m) Ym((i - 1) * i / 2 + (k - 1), 10 * n + m) = T(m, i - 1) * T(m, k - 1);
+        for (int m = 0; m < n; ++m)
+          Ym((i - 1) * i / 2 + (k - 1), 10 * n + m) = T(m, i - 1) * T(m, k - 1);
     }
   }
 }

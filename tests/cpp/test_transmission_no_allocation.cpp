@@ -121,7 +121,7 @@ int main() {
 
   dynid::Model copy = model;
   dynid::MatrixX wrong(n, n + 1), nan = dynid::MatrixX::Identity(n, n),
-      singular = dynid::MatrixX::Identity(n, n);
+                                  singular = dynid::MatrixX::Identity(n, n);
   nan(1, 2) = std::numeric_limits<double>::quiet_NaN();
   singular.row(3) = singular.row(4);
   bool ok = true;

@@ -239,7 +239,8 @@ def stable_substeps(
 
     There the friction and the controller's damping act as a viscous term D = diag(Fv + Fs /
     band + Kd) (with coupled drives T^T diag(Fv + Fs / band) T + diag(Kd)), whose fastest mode
-    decays at the largest eigenvalue of M^-1 D; RK4 is stable for rate * h < 2.78, and h is chosen for rate * h <= 2 (at the configuration q).
+    decays at the largest eigenvalue of M^-1 D; RK4 is stable for rate * h < 2.78, and h is
+    chosen for rate * h <= 2 (at the configuration q).
     """
     T = robot.transmission
     motor = T.T @ np.diag(robot.Fv + robot.Fs / coulomb_band) @ T

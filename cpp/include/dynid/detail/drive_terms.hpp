@@ -87,8 +87,8 @@ inline void add_drive_linear(const Model& model, const Vel& vel, const Acc& acc,
     return;
   }
   for (int k = 0; k < model.n(); ++k)
-    add_motor_torque(model, k, Ia[k] * motor_value(model, k, acc) + Fv[k] * motor_value(model, k, vel),
-                     out);
+    add_motor_torque(model, k,
+                     Ia[k] * motor_value(model, k, acc) + Fv[k] * motor_value(model, k, vel), out);
 }
 
 // M += T^T diag(Ia) T: the rotors' part of the mass matrix.
