@@ -142,3 +142,51 @@ def test_overflow_in_any_sample_is_reported(call: str, isa: str) -> None:
             getattr(robot, call)(*(s[k] for k in names), out=out)
     finally:
         _core._set_batch_isa(before)
+
+
+# ------------------------------------------------------------- recycled memory of large results
+
+
+def _address(a: np.ndarray) -> int:
+    return int(a.__array_interface__["data"][0])
+
+
+def test_large_results_recycle_freed_memory_and_never_a_live_result() -> None:
+    """A large batch result (>= 4 MiB) reuses the block of a result that was freed, never the
+    block of one that is alive; the values equal those written into a caller's ``out=`` (exact:
+    the same kernel) and per-sample calls (the scalar kernel, to 1e-12 of the largest entry)."""
+    robot = dynid.models.kuka_lwr4()
+    rng = np.random.default_rng(7)
+    T = 2000  # 2000 x 7 x 70 doubles = 7.8 MB
+    first_inputs = [rng.standard_normal((T, 7)) for _ in range(3)]
+    second_inputs = [rng.standard_normal((T, 7)) for _ in range(3)]
+    first = robot.regressor(*first_inputs)
+    kept = first.copy()
+    second = robot.regressor(*second_inputs)  # first is alive: its memory must not be reused
+    assert not np.shares_memory(first, second)
+    np.testing.assert_array_equal(first, kept)
+    freed = _address(second)
+    del second
+    third = robot.regressor(*second_inputs)
+    assert _address(third) == freed  # the freed block, already mapped
+    np.testing.assert_array_equal(third, robot.regressor(*second_inputs, out=np.empty_like(kept)))
+    for t in (0, 999, T - 1):
+        single = robot.regressor(*(x[t] for x in second_inputs))
+        np.testing.assert_allclose(third[t], single, rtol=0, atol=1e-12 * np.abs(single).max())
+
+
+def test_recycled_memory_is_bounded_and_small_results_are_numpys() -> None:
+    """At most 4 blocks and 256 MiB wait for reuse; a result larger than that is returned to the
+    system when it dies; results under 4 MiB are ordinary NumPy arrays owning their data."""
+    robot = dynid.models.kuka_lwr4()
+    q = np.random.default_rng(8).standard_normal((12_000, 7))
+    results = [robot.mass_matrix(q + k) for k in range(6)]  # 4.7 MB each
+    del results
+    blocks, size = _core._result_pool()
+    assert 1 <= blocks <= 4 and size <= 256 << 20
+    big = robot.mass_matrix(np.zeros((700_000, 7)))  # 274 MB: more than the pool keeps
+    assert not big.flags.owndata
+    del big
+    assert _core._result_pool()[1] <= 256 << 20
+    small = robot.mass_matrix(q[:100])
+    assert small.flags.owndata

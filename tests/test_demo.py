@@ -140,6 +140,25 @@ def test_cli_demo_returns_zero_and_writes_its_outputs(tmp_path, capsys):
         png_size(out / name)
 
 
+def test_demo_never_overwrites_results_silently(tmp_path, capsys):
+    """A second demo into the same folder is refused (exit 2, one line, the old files kept);
+    with --overwrite the folder is replaced as a whole (a stray file of the old one is gone)."""
+    out = tmp_path / "demo"
+    argv = ["demo", "--output", str(out), "--train", "10", "--validation", "5"]
+    assert dynid.cli.main(argv) == 0
+    (out / "notes.txt").write_text("mine")
+    before = (out / "demo.json").read_bytes()
+    capsys.readouterr()
+    assert dynid.cli.main(argv) == 2
+    error = capsys.readouterr().err.strip()
+    assert error.startswith("dynid demo: error: output:") and "--overwrite" in error
+    assert (out / "demo.json").read_bytes() == before and (out / "notes.txt").exists()
+    assert dynid.cli.main([*argv, "--overwrite"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == sorted(["demo.json", *PLOTS])
+    with pytest.raises(ValueError, match=r"^output:"):
+        run_demo(out, train=10, validation=5, progress=lambda _: None)
+
+
 def test_cli_rejects_an_unknown_command(capsys):
     with pytest.raises(SystemExit) as info:
         dynid.cli.main(["nonsense"])

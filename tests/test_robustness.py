@@ -162,6 +162,23 @@ def test_write_text_atomic(tmp_path) -> None:
     assert [p.name for p in tmp_path.iterdir()] == ["x.txt"]
 
 
+def test_results_get_the_permissions_of_new_files(tmp_path) -> None:
+    """The staging folder and the atomic file are created private (mkstemp's 0o600); what is
+    left in place has the permissions any new folder or file gets under the umask."""
+    import os
+    import stat
+
+    previous = os.umask(0o022)
+    try:
+        with output_folder(tmp_path / "run") as staging:
+            (staging / "a.json").write_text("{}")
+        write_text_atomic(tmp_path / "x.txt", "one")
+    finally:
+        os.umask(previous)
+    assert stat.S_IMODE((tmp_path / "run").stat().st_mode) == 0o755
+    assert stat.S_IMODE((tmp_path / "x.txt").stat().st_mode) == 0o644
+
+
 # --------------------------------------------------------------------------- item 13
 
 
@@ -365,7 +382,7 @@ def test_result_file_carries_covariance_units_and_version(small_result, tmp_path
     assert np.allclose(loaded.covariance, small_result.covariance, rtol=1e-15, atol=0)
     data["version"] = 99
     path.write_text(json.dumps(data))
-    with pytest.raises(ValueError, match=r"version: expected a format version 1..2"):
+    with pytest.raises(ValueError, match=r"version: expected a format version 1\.\.3"):
         load_result(path)
 
 

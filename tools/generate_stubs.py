@@ -49,6 +49,10 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     "out": f"{ARRAY} | None",
     "columns": f"{ARRAY_LIKE} | None",
     ("_sincos", "x"): ARRAY_LIKE,
+    # second-order-section filter (dynid._iir checks and passes these)
+    ("_sos_filter", "sections"): ARRAY_LIKE,
+    ("_sos_filter", "x"): ARRAY_LIKE,
+    ("_sos_filter", "state"): ARRAY_LIKE,
     # model geometry and bodies
     "dh": ARRAY_LIKE,
     "gravity": ARRAY_LIKE,

@@ -1,5 +1,7 @@
 #include "arrays.hpp"
 
+#include "result_pool.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -163,7 +165,7 @@ bool all_finite(const double* data, py::ssize_t n) {
 }
 
 py::array_t<double> output_array(py::handle out, const std::vector<py::ssize_t>& shape) {
-  if (out.is_none()) return py::array_t<double>(shape);
+  if (out.is_none()) return new_result_array(shape);
   std::string want = "(";
   for (std::size_t k = 0; k < shape.size(); ++k) want += (k ? ", " : "") + std::to_string(shape[k]);
   want += shape.size() == 1 ? ",)" : ")";

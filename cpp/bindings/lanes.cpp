@@ -1,6 +1,8 @@
 // Python access to the batch path selection (tests run every path the CPU supports).
 #include "lanes.hpp"
 
+#include "result_pool.hpp"
+
 namespace dynid::binding {
 
 void bind_lanes(py::module_& m) {
@@ -32,6 +34,14 @@ void bind_lanes(py::module_& m) {
       },
       py::arg("x"),
       "sin and cos of the flattened x by the vectorised sincos the kernels use (tests).");
+  m.def(
+      "_result_pool",
+      [] {
+        const auto [blocks, bytes] = pooled_blocks();
+        return py::make_tuple(blocks, bytes);
+      },
+      "(blocks, bytes) of large batch results' memory waiting for reuse (result_pool.hpp; "
+      "tests).");
   m.def(
       "_supported_batch_isas",
       [] {

@@ -8,6 +8,7 @@
 #include "lanes.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
+#include "signal.hpp"
 #include "simulator.hpp"
 #include "text_signatures.hpp"
 #include "uses.hpp"
@@ -23,6 +24,7 @@ PYBIND11_MODULE(_core, m) {
   dynid::binding::bind_lanes(m);
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
+  dynid::binding::bind_signal(m);
   m.def(
       "standard_parameters",
       [](double mass, py::handle com, py::handle inertia_com) {

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
     from .cmake import get_cmake_dir, get_include
     from .elastic import ElasticRobot
     from .elastic_identification import DriveIdentification, identify_drives
+    from .errors import PhysicalIdentificationError
     from .excitation import FourierTrajectory, optimize_excitation
     from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
     from .identify import LeastSquaresResult, RankDeficientError, least_squares
@@ -48,7 +49,7 @@ if TYPE_CHECKING:
     from .io.result_files import load_result, save_result
     from .log_identification import LogIdentification, identify_log, validate_log
     from .payload import PayloadEstimate, estimate_payload, payload_from_identified
-    from .physical import PhysicalIdentificationError, PhysicalResult, physical_least_squares
+    from .physical import PhysicalResult, physical_least_squares
     from .recursive import RecursiveLeastSquares
     from .sim import VirtualController, simulate
     from .streaming import LeastSquaresAccumulator, least_squares_streaming
@@ -85,7 +86,7 @@ _LAZY = {
     "LogIdentification": ".log_identification",
     "identify_log": ".log_identification",
     "validate_log": ".log_identification",
-    "PhysicalIdentificationError": ".physical",
+    "PhysicalIdentificationError": ".errors",
     "PhysicalResult": ".physical",
     "physical_least_squares": ".physical",
     "RecursiveLeastSquares": ".recursive",

@@ -510,6 +510,11 @@ def _last_batch_threads() -> int:
     Threads the last batch call ran on.
     """
 
+def _result_pool() -> tuple[int, int]:
+    """
+    (blocks, bytes) of large batch results' memory waiting for reuse (result_pool.hpp; tests).
+    """
+
 def _set_batch_isa(isa: str) -> None:
     """
     Force a batch path (for tests); also DYNID_BATCH_ISA at import. ValueError when the CPU cannot run it.
@@ -599,6 +604,13 @@ def _sincos(
 ) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
     """
     sin and cos of the flattened x by the vectorised sincos the kernels use (tests).
+    """
+
+def _sos_filter(
+    sections: numpy.typing.ArrayLike, x: numpy.typing.ArrayLike, state: numpy.typing.ArrayLike
+) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]:
+    """
+    Filter the columns of x (T, C) through the second-order sections (S, 6) from the initial state (S, 2, C) (transposed direct form II, as scipy.signal.sosfilt with zi); returns (y, final state).
     """
 
 def _supported_batch_isas() -> list:

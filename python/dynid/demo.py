@@ -24,10 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import models, plots
+from . import models
 from ._checks import count
 from ._threads import blas_single_threaded
 from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
+from .io.output_folder import check_output_path, output_folder
 from .robot import Robot
 from .signal import differentiate, lowpass
 from .sim import StaticReadings, VirtualController, paper_validation_trajectory
@@ -92,11 +93,15 @@ def run_demo(
     link_friction: float = LINK_FRICTION,
     seed: int = 0,
     progress: Callable[[str], None] = print,
+    overwrite: bool = False,
 ) -> dict:
-    """Run the demo, write JSON and PNGs into ``output`` and return the JSON content."""
+    """Run the demo, write JSON and PNGs into ``output`` and return the JSON content.
+
+    ``output`` must not exist or be empty unless ``overwrite`` is True; its files are written
+    into a temporary folder that replaces it at the end (:mod:`dynid.io.output_folder`), so an
+    earlier demo's results are never mixed with or lost to a run that fails."""
     train, validation = check_demo_sizes(train, validation)
-    out = Path(output)
-    out.mkdir(parents=True, exist_ok=True)
+    check_output_path(output, overwrite)  # before the work, not after
     start = time.perf_counter()
     steps = 6
 
@@ -196,55 +201,61 @@ def run_demo(
         )
 
     # 6. Files.
-    files = [
-        plots.plot_joint_signals(
-            recording.t,
-            q,
-            qd,
-            qdd,
-            out / "fig3_joint_motion.png",
-            "Filtered joint positions, velocities and accelerations (eq. 33)",
-        ),
-        plots.plot_torques(
-            recording.t,
-            tau,
-            tau_hat,
-            out / "fig4_torques.png",
-            "Sensed joint torques (filtered) and estimated torques, eq. (26)",
-        ),
-        plots.plot_element_comparison(
-            {
-                "g_2(q) [N m]": (checking.g[:, 1], ident.gravity(checking.q)[:, 1]),
-                "M_11(q) [kg m^2]": (checking.M[:, 0, 0], ident.mass_matrix(checking.q)[:, 0, 0]),
+    from . import plots  # matplotlib: imported when plotting
+
+    with output_folder(output, overwrite) as staging:
+        files = [
+            plots.plot_joint_signals(
+                recording.t,
+                q,
+                qd,
+                qdd,
+                staging / "fig3_joint_motion.png",
+                "Filtered joint positions, velocities and accelerations (eq. 33)",
+            ),
+            plots.plot_torques(
+                recording.t,
+                tau,
+                tau_hat,
+                staging / "fig4_torques.png",
+                "Sensed joint torques (filtered) and estimated torques, eq. (26)",
+            ),
+            plots.plot_element_comparison(
+                {
+                    "g_2(q) [N m]": (checking.g[:, 1], ident.gravity(checking.q)[:, 1]),
+                    "M_11(q) [kg m^2]": (
+                        checking.M[:, 0, 0],
+                        ident.mass_matrix(checking.q)[:, 0, 0],
+                    ),
+                },
+                staging / "fig6_g2_M11.png",
+                "Validation set: controller values and identified model",
+            ),
+        ]
+        report = {
+            "robot": structure.name,
+            "settings": {
+                "train": train,
+                "validation": validation,
+                "seed": seed,
+                "link_friction": link_friction,
+                **noise,
             },
-            out / "fig6_g2_M11.png",
-            "Validation set: controller values and identified model",
-        ),
-    ]
-    report = {
-        "robot": structure.name,
-        "settings": {
-            "train": train,
-            "validation": validation,
-            "seed": seed,
-            "link_friction": link_friction,
-            **noise,
-        },
-        "tracking_error_max": [float(e) for e in tracking],
-        "coefficients": ident.coefficients(),
-        "zero_elements": [vars(z) for z in ident.zero_elements],
-        "gravity_errors": {"TS": _lists(g_ts), "VS": _lists(g_vs), "TVE": _lists(tve)},
-        "inertia_errors": {"TS": m_ts, "VS": m_vs},
-        "condition_numbers": {
-            "gravity": ident.gravity_fit.condition_number,
-            "inertia": ident.inertia_fit.condition_number,
-        },
-        "payload": {"true_mass": TIP_MASS, "estimates": estimates},
-        "plots": [p.name for p in files],
-        "seconds": round(time.perf_counter() - start, 2),
-    }
-    (out / "demo.json").write_text(json.dumps(report, indent=1))
-    step(6, f"wrote {out / 'demo.json'} and {len(files)} plots")
+            "tracking_error_max": [float(e) for e in tracking],
+            "coefficients": ident.coefficients(),
+            "zero_elements": [vars(z) for z in ident.zero_elements],
+            "gravity_errors": {"TS": _lists(g_ts), "VS": _lists(g_vs), "TVE": _lists(tve)},
+            "inertia_errors": {"TS": m_ts, "VS": m_vs},
+            "condition_numbers": {
+                "gravity": ident.gravity_fit.condition_number,
+                "inertia": ident.inertia_fit.condition_number,
+            },
+            "payload": {"true_mass": TIP_MASS, "estimates": estimates},
+            "plots": [p.name for p in files],
+            "seconds": round(time.perf_counter() - start, 2),
+        }
+        (staging / "demo.json").write_text(json.dumps(report, indent=1))
+    step(6, f"wrote {Path(output) / 'demo.json'} and {len(files)} plots")
     return report
 
 

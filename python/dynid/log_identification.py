@@ -6,10 +6,12 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
 1. the log is prepared (``dynid.io.prepare_log``: filtering, differentiation, decimation, sample
    removal; each step only when asked, each in ``log.notes``);
 2. the regressor Y(q, qd, qdd) of every sample is computed in one batch call (C++), with the
-   rotor (Ia) and friction (Fv, Fs) columns when asked, and reduced to the base parameters
-   (``dynid.base_parameters``);
-3. optionally one constant column per joint is appended: a torque offset (sensor bias; with
-   Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-); and, optionally, a
+   rotor (Ia) and symmetric friction (Fv, Fs) columns when asked, and reduced to the base
+   parameters (``dynid.base_parameters``);
+3. optionally the asymmetric friction columns are appended (``dynid.friction_models``: Fv+,
+   Fv-, Fs+, Fs- per joint, in place of Fv, Fs); one constant column per joint: a torque offset
+   (sensor bias; with Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-); and,
+   optionally, a
    position torque ks_j sin q_j + kc_j cos q_j per joint (``dynid.position_torque``: a
    once-per-turn torque of the joint's sensor, gear or cables; only on the joints where it is
    structurally identifiable);
@@ -17,7 +19,8 @@ Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
    chunk into triangular factors, the solver of ``dynid.identify.least_squares``);
 5. with ``physical=True``, the standard parameters are then estimated by the physically
    consistent semidefinite programme (``dynid.physical.physical_least_squares``: same columns,
-   same WLS weights, the offsets and position torques unconstrained, optionally a prior model),
+   same WLS weights, the asymmetric friction coefficients >= 0, the offsets and position
+   torques unconstrained, optionally a prior model),
    and the result carries
    that robot (``result.robot``, saved with the result) and its base values as ``theta``.
 
@@ -39,6 +42,7 @@ from numpy.typing import NDArray
 
 from ._equality import ValueEquality
 from .base_parameters import base_parameters
+from .friction_models import asymmetric_columns, asymmetric_count, asymmetric_names, friction_model
 from .identify import VARIANCE_FLOOR
 from .io.log_files import Log
 from .io.model_files import load_model, model_from_dict, model_to_dict
@@ -81,15 +85,21 @@ class LogIdentification(ValueEquality):
     :func:`identify_log`.
 
     ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
-    (``expressions`` gives each as a combination of the standard ones), then the offsets.
+    (``expressions`` gives each as a combination of the standard ones), then the asymmetric
+    friction coefficients, the offsets and the position torques, when asked for.
     ``independent`` and ``beta`` are those of :class:`dynid.BaseParameters` for the model's
     regressor columns ``parameter_names``. ``training`` holds the training log's source, size,
     preparation (options and notes, in words) and per-joint fit metrics.
 
+    ``friction`` says whether the regressor's symmetric friction columns (Fv, Fs) are among the
+    ``parameter_names``; ``asymmetric_friction`` whether the asymmetric ones
+    (:mod:`dynid.friction_models`) follow the base parameters instead; ``friction_model`` names
+    the model ("none", "symmetric", "asymmetric").
+
     A physically consistent result (``identify_log(physical=True)``) has ``physical`` set (the
     solver's report: status, solver, times, prior, prior_weight, margin) and ``model`` holds the
     identified standard parameters and drive terms, so ``robot`` is the identified robot;
-    ``theta`` holds its base values (beta @ pi) and the offsets; ``std`` is inf and
+    ``theta`` holds its base values (beta @ pi) and the other coefficients; ``std`` is inf and
     ``covariance`` None (the constrained estimate has no least-squares covariance).
     """
 
@@ -115,6 +125,9 @@ class LogIdentification(ValueEquality):
     physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
     #: joints (0-based) with a position torque ks_j sin q_j + kc_j cos q_j (``position_torque``)
     position_joints: tuple[int, ...] = ()
+    #: whether the asymmetric friction columns (Fv+, Fv-, Fs+, Fs-; Fs with offsets) are in
+    #: ``theta`` after the base parameters (then ``friction`` is False)
+    asymmetric_friction: bool = False
     #: the prepared training log (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
     _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
@@ -139,13 +152,29 @@ class LogIdentification(ValueEquality):
         return self._robot
 
     @property
+    def friction_model(self) -> str:
+        """The friction model: "none", "symmetric" or "asymmetric" (:mod:`.friction_models`)."""
+        if self.asymmetric_friction:
+            return "asymmetric"
+        return "symmetric" if self.friction else "none"
+
+    @property
+    def offsets(self) -> NDArray[np.float64]:
+        """(n,) the identified torque offsets (zeros without ``offset``)."""
+        if not self.offset:
+            return np.zeros(self.n)
+        first = self.count + (asymmetric_count(self.n, True) if self.asymmetric_friction else 0)
+        return np.asarray(self.theta[first : first + self.n], dtype=float)
+
+    @property
     def position_torque(self) -> bool:
         """Whether the model has position-torque columns (on ``position_joints``)."""
         return bool(self.position_joints)
 
     def regressor(self, q: Any, qd: Any, qdd: Any) -> NDArray[np.float64]:
-        """The (T, n, p) regressor of ``theta``: base columns, then the offset columns, then the
-        position-torque columns (sin q_j, cos q_j of each of ``position_joints``)."""
+        """The (T, n, p) regressor of ``theta``: base columns, then the asymmetric friction
+        columns, the offset columns and the position-torque columns (sin q_j, cos q_j of each of
+        ``position_joints``), as many as the options ask for."""
         robot = self.robot
         total = robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
         if total != len(self.parameter_names):
@@ -159,13 +188,28 @@ class LogIdentification(ValueEquality):
         )
         if Y.ndim == 2:
             Y = Y[None]
+        return np.concatenate([Y, self.extra_columns(q, qd)], axis=2)
+
+    def extra_columns(self, q: Any, qd: Any) -> NDArray[np.float64]:
+        """(T, n, e) the columns of ``theta`` after the base parameters (asymmetric friction,
+        offsets, position torque): functions of q and qd only, none of the robot's parameters."""
+        q = np.asarray(q, dtype=float).reshape(-1, self.n)
+        blocks = [np.zeros((q.shape[0], self.n, 0))]
+        if self.asymmetric_friction:
+            qd = np.asarray(qd, dtype=float).reshape(q.shape)
+            blocks.append(asymmetric_columns(qd, self.offset))
         if self.offset:
-            ones = np.broadcast_to(np.eye(self.n), (Y.shape[0], self.n, self.n))
-            Y = np.concatenate([Y, ones], axis=2)
+            blocks.append(np.broadcast_to(np.eye(self.n), (q.shape[0], self.n, self.n)))
         if self.position_joints:
-            q2 = np.asarray(q, dtype=float).reshape(Y.shape[0], self.n)
-            Y = np.concatenate([Y, position_columns(q2, self.position_joints)], axis=2)
-        return Y
+            blocks.append(position_columns(q, self.position_joints))
+        return np.concatenate(blocks, axis=2)
+
+    def extra_torque(self, q: Any, qd: Any) -> NDArray[np.float64]:
+        """(T, n) the torque of the :meth:`extra_columns` (asymmetric friction, offsets,
+        position torque): what the identified model adds to the rigid-body (+ rotor, symmetric
+        friction) torque of its base parameters."""
+        extra = self.extra_columns(q, qd)
+        return extra @ self.theta[self.count : self.count + extra.shape[2]]
 
     def predict(self, log: Log) -> NDArray[np.float64]:
         """Predicted joint torques (T, n) on ``log`` (qd, qdd computed from q when absent).
@@ -180,10 +224,15 @@ class LogIdentification(ValueEquality):
         the per-joint fit on the training log, as text."""
         options = ", ".join(
             k.replace("_", " ")
-            for k in ("rotor", "friction", "offset", "position_torque")
+            for k in ("rotor", "friction", "asymmetric_friction", "offset", "position_torque")
             if getattr(self, k)
         )
-        offsets = f" + {self.n} offsets" if self.offset else ""
+        offsets = ""
+        if self.asymmetric_friction:
+            offsets += (
+                f" + {asymmetric_count(self.n, self.offset)} asymmetric friction coefficients"
+            )
+        offsets += f" + {self.n} offsets" if self.offset else ""
         if self.position_joints:
             offsets += (
                 f" + position torque on joint(s) "
@@ -234,7 +283,7 @@ def identify_log(
     robot: Robot,
     *,
     rotor: bool = False,
-    friction: bool = False,
+    friction: bool | str = False,
     offset: bool = False,
     method: str = "wls",
     exclude_joints: Sequence[int] = (),
@@ -248,8 +297,11 @@ def identify_log(
 
     ``preparation``: options of :func:`dynid.io.prepare_log` (cutoff, order, differentiate,
     decimate, min_velocity, outlier_k) applied first; qd and qdd are computed from q when the log
-    lacks them. ``rotor``/``friction`` add the Ia and Fv, Fs columns, ``offset`` one constant
-    torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
+    lacks them. ``rotor`` adds the Ia columns; ``friction`` the friction model: False ("none"),
+    True or "symmetric" (Fv qd + Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a
+    coefficient per direction of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
+    Coulomb asymmetry: :mod:`dynid.friction_models`). ``offset`` adds one constant torque per
+    joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
     these two columns are structurally identifiable next to the others
     (:func:`dynid.position_torque.position_torque_joints`; the joints left out are named in
     ``training["notes"]``): a joint-side torque that depends on the joint's own position (torque
@@ -261,7 +313,8 @@ def identify_log(
 
     ``physical=True`` estimates physically consistent standard parameters instead
     (:func:`dynid.physical_least_squares`, same columns; WLS weights 1/sigma_j from the
-    least-squares residuals; the offsets unconstrained; excluded joints weighted 0). ``prior`` is a
+    least-squares residuals; the asymmetric friction coefficients >= 0, the offsets and
+    position torques unconstrained; excluded joints weighted 0). ``prior`` is a
     Robot, a URDF file or a model file (``dynid.load_model``: JSON/YAML or a built-in name) of
     the same arm, in any DH table (re-expressed in ``robot``'s frames by
     :func:`dynid.link_frames.express_in_frames_of` when needed); ``prior_weight`` defaults to
@@ -276,6 +329,8 @@ def identify_log(
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
         raise ValueError(f"physical: expected True or False, got {physical!r}")
+    kind = friction_model(friction)
+    symmetric, asymmetric = kind == "symmetric", kind == "asymmetric"
     if not isinstance(position_torque, (bool, np.bool_)):
         raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
     if not physical and (prior is not None or prior_weight is not None):
@@ -287,22 +342,30 @@ def identify_log(
     prepared = _with_derivatives(prepare_log(log, **options), robot.n, robot.name)
     qd, qdd = prepared.qd, prepared.qdd
     assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
-    base = base_parameters(robot, "torque", rotor=bool(rotor), friction=bool(friction))
+    base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
     names, expressions = list(base.names), list(base.expressions)
+    if asymmetric:
+        more_names, more_expressions = asymmetric_names(robot.n, bool(offset))
+        names += more_names
+        expressions += more_expressions
     if offset:
         names += [f"{OFFSET_NAME}{j}" for j in range(1, robot.n + 1)]
         expressions += [f"torque offset of joint {j}" for j in range(1, robot.n + 1)]
     joints: tuple[int, ...] = ()
     left_out: tuple[int, ...] = ()
     if position_torque:
-        joints, left_out = position_torque_joints(robot, bool(rotor), bool(friction), bool(offset))
+        # The symmetric friction columns stand in for the asymmetric ones: sin q_j, cos q_j
+        # are functions of q_j, independent of any function of qd_j alone either way.
+        joints, left_out = position_torque_joints(
+            robot, bool(rotor), symmetric or asymmetric, bool(offset)
+        )
         more_names, more_expressions = position_names(joints)
         names += more_names
         expressions += more_expressions
     result = LogIdentification(
         model=model_to_dict(robot),
         rotor=bool(rotor),
-        friction=bool(friction),
+        friction=symmetric,
         offset=bool(offset),
         method=method,
         parameter_names=list(base.parameter_names),
@@ -317,6 +380,7 @@ def identify_log(
         rank=0,
         log=prepared,
         position_joints=joints,
+        asymmetric_friction=asymmetric,
         _robot=robot,
     )
     # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
@@ -370,11 +434,12 @@ def _physical(
     Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
     if Y.ndim == 2:
         Y = Y[None]
-    extra = (n if result.offset else 0) + 2 * len(result.position_joints)
-    if result.offset:
-        Y = np.concatenate([Y, np.broadcast_to(np.eye(n), (Y.shape[0], n, n))], axis=2)
-    if result.position_joints:
-        Y = np.concatenate([Y, position_columns(log.q, result.position_joints)], axis=2)
+    columns = result.extra_columns(log.q, log.qd)
+    Y = np.concatenate([Y, columns], axis=2)
+    # Friction dissipates: the asymmetric coefficients are >= 0, as Fv and Fs are.
+    nonnegative = np.zeros(columns.shape[2], dtype=bool)
+    if result.asymmetric_friction:
+        nonnegative[: asymmetric_count(n, result.offset)] = True
     weights = np.ones(n)
     kept = [j for j in range(n) if j not in result.excluded]
     usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
@@ -391,7 +456,8 @@ def _physical(
         weights=weights,
         prior=prior,
         prior_weight=prior_weight,
-        extra_columns=extra,
+        extra_columns=columns.shape[2],
+        nonnegative_extra=nonnegative,
     )
     result.theta = np.concatenate([fit.base_values, fit.extra])
     result.std = np.full(result.theta.size, np.inf)

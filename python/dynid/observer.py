@@ -51,7 +51,9 @@ def robot_from_identification(result: LogIdentification) -> tuple[Robot, Array]:
     The identified coefficients are base parameters, tau = Y[:, independent] theta; a standard
     parameter vector holding theta at the independent columns and zero elsewhere gives the same
     Y pi for every (q, qd, qdd), hence the same M(q), c, g and friction (drive terms not
-    identified are zero). Its parameters are not physically meaningful one by one.
+    identified are zero). Its parameters are not physically meaningful one by one. The other
+    columns of the result (asymmetric friction, position torque: ``result.extra_torque``) are
+    not part of the robot.
     """
     if not isinstance(result, LogIdentification):
         raise ValueError(
@@ -68,20 +70,21 @@ def robot_from_identification(result: LogIdentification) -> tuple[Robot, Array]:
     column += n if result.rotor else 0
     robot.Fv = pi[column : column + n] if result.friction else np.zeros(n)
     robot.Fs = pi[column + n : column + 2 * n] if result.friction else np.zeros(n)
-    offsets = result.theta[result.count :] if result.offset else np.zeros(n)
-    return robot, np.array(offsets, dtype=float)
+    return robot, result.offsets.copy()
 
 
 def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | Array) -> Residual:
     """Run :class:`dynid.MomentumObserver` over ``log`` (uniformly sampled; qd computed from q
     when absent) with ``gain`` (1/s, a number or one per joint) at the log's median sample
-    period. With an identified model its torque offsets are taken off the measured torques."""
+    period. With an identified model, the torques of its columns that are not the robot's
+    (offsets, asymmetric friction, position torque: ``extra_torque(q, qd)``) are taken off the
+    measured torques."""
     from .robot import Robot
 
     if isinstance(model, Robot):
-        robot, offsets = model, np.zeros(model.n)
+        robot = model
     else:
-        robot, offsets = robot_from_identification(model)
+        robot, _ = robot_from_identification(model)
     if not isinstance(log, Log):
         raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
     if log.n != robot.n:
@@ -92,7 +95,8 @@ def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | 
     dt = float(np.median(np.diff(log.t)))
     observer = _core.MomentumObserver(robot, gain, dt)
     assert log.qd is not None  # measured, or differentiated just above
-    r = observer.run(log.q, log.qd, log.tau - offsets)
+    extra = 0.0 if isinstance(model, Robot) else model.extra_torque(log.q, log.qd)
+    r = observer.run(log.q, log.qd, log.tau - extra)
     return Residual(
         t=log.t.copy(),
         r=r,

@@ -11,7 +11,8 @@ for physically consistent inertial parameter identification", IEEE RA-L 3(1), 20
 
     minimise    || W (Y pi - tau) ||^2 / || W tau ||^2  +  prior_weight * d(pi, pi_prior)
     subject to  J_i(pi) - margin * I_4  positive semidefinite      (every link i)
-                Ia >= 0,  Fv >= 0,  Fs >= 0,  optional bounds on each m_i and on sum m_i.
+                Ia >= 0,  Fv >= 0,  Fs >= 0,  optional bounds on each m_i and on sum m_i,
+                the extra columns' coefficients marked ``nonnegative_extra`` >= 0.
 
 The first term is the weighted residual relative to the weighted torques (scale-free: 1e-4 is a
 1 % relative RMS error). The second is zero without a prior; with one it is the sum over the
@@ -49,9 +50,11 @@ from . import _checks as checks
 from ._checks import positive
 from ._equality import ValueEquality
 from .base_parameters import base_parameters
+from .errors import PhysicalIdentificationError
 from .physical_arguments import (
     check_data,
     check_mass_bounds,
+    check_nonnegative_extra,
     check_prior,
     check_prior_weight,
     check_total_mass,
@@ -83,15 +86,6 @@ PROJECTION_TOLERANCE = 1e-6
 SOLVER = "CLARABEL"
 
 
-class PhysicalIdentificationError(RuntimeError):
-    """The semidefinite programme was not solved to optimality (``status`` says how it ended:
-    e.g. "infeasible" when the mass bounds contradict the total mass)."""
-
-    def __init__(self, message: str, status: str) -> None:
-        super().__init__(message)
-        self.status = status
-
-
 @dataclass(eq=False)
 class PhysicalResult(ValueEquality):
     """A physically consistent estimate (see :func:`physical_least_squares`); pickles, copies
@@ -102,7 +96,7 @@ class PhysicalResult(ValueEquality):
     Ia: NDArray[np.float64] | None  #: (n,) when rotor=True
     Fv: NDArray[np.float64] | None  #: (n,) when friction=True
     Fs: NDArray[np.float64] | None  #: (n,) when friction=True
-    extra: NDArray[np.float64]  #: (extra_columns,) the unconstrained coefficients
+    extra: NDArray[np.float64]  #: (extra_columns,) the coefficients of the extra columns
     theta: NDArray[np.float64]  #: (P + extra_columns,) the whole estimate, Y @ theta predicts tau
     base_values: NDArray[np.float64]  #: base.beta @ pi (p,), base of the torque regressor
     base_names: list[str]
@@ -132,6 +126,7 @@ def physical_least_squares(
     total_mass: float | Sequence[float] | None = None,
     margin: float = DEFAULT_MARGIN,
     extra_columns: int = 0,
+    nonnegative_extra: ArrayLike | None = None,
 ) -> PhysicalResult:
     """Physically consistent least squares over the standard parameters (module docstring).
 
@@ -164,7 +159,13 @@ def physical_least_squares(
     margin
         J_i - margin I_4 positive semidefinite (see :data:`DEFAULT_MARGIN`), > 0.
     extra_columns
-        Number of trailing columns of Y with unconstrained coefficients (e.g. torque offsets).
+        Number of trailing columns of Y whose coefficients are not standard parameters (e.g.
+        torque offsets): unconstrained, except those marked in ``nonnegative_extra``.
+    nonnegative_extra
+        None, or (extra_columns,) booleans: the extra coefficients constrained >= 0 (e.g. the
+        asymmetric friction coefficients Fv+, Fv-, Fs+, Fs- of
+        :mod:`dynid.friction_models`); after the solve, values negative by a solver tolerance
+        are set to 0, as for Ia, Fv, Fs.
 
     After the solve, each link's pseudo-inertia is moved to the nearest matrix (Frobenius norm)
     with eigenvalues >= margin, and Ia, Fv, Fs negative by a solver tolerance set to 0: this
@@ -186,6 +187,7 @@ def physical_least_squares(
     n = robot.n
     P = robot.parameter_vector(rotor, friction).size
     k = checks.count(extra_columns, "extra_columns", 0)
+    nonnegative = check_nonnegative_extra(nonnegative_extra, k)
     Y3, tau2 = check_data(Y, tau, n, P + k)
     w = check_weights(weights, Y3.shape[0], n)
     margin = positive(margin, "margin")
@@ -211,6 +213,8 @@ def physical_least_squares(
     x = cp.hstack(parts)
     terms = [R @ cp.multiply(column / b_norm, x) - c, np.array([r0])]
     constraints = [Ji - margin * np.eye(4) >> 0 for Ji in J]
+    if free is not None and nonnegative.any():
+        constraints += [free[np.flatnonzero(nonnegative)] >= 0]
     masses = cp.hstack([Ji[3, 3] for Ji in J])
     if lower is not None:
         assert upper is not None  # check_mass_bounds gives both or neither
@@ -266,6 +270,7 @@ def physical_least_squares(
             "inaccurate",
         )
     extra = np.asarray(free.value, dtype=float) if free is not None else np.zeros(0)
+    extra[nonnegative] = np.maximum(extra[nonnegative], 0.0)
     theta = np.concatenate([params.reshape(-1), drive_values, extra])
     identified = _identified_robot(robot, params, drive_values, rotor, friction)
     min_eig = np.array([np.linalg.eigvalsh(pseudo_inertia(p))[0] for p in params])
@@ -298,6 +303,7 @@ def physical_least_squares(
             "prior_weight": prior_weight,
             "margin": margin,
             "extra_columns": k,
+            "nonnegative_extra": np.flatnonzero(nonnegative).tolist(),
             "prior": prior is not None,
         },
     )

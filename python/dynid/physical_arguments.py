@@ -149,3 +149,16 @@ def check_total_mass(value: Any) -> tuple[float, float] | None:
             f"0 <= lower <= upper, upper > 0, got {value!r}"
         )
     return float(bounds[0]), float(bounds[1])
+
+
+def check_nonnegative_extra(value: Any, k: int) -> NDArray[np.bool_]:
+    """``nonnegative_extra``: None (no extra coefficient constrained) or k booleans."""
+    if value is None:
+        return np.zeros(k, dtype=bool)
+    mask = np.asarray(value)
+    if mask.dtype != np.bool_ or mask.shape != (k,):
+        raise ValueError(
+            f"nonnegative_extra: expected None or {k} booleans (one per extra column), got "
+            f"{mask.dtype} of shape {mask.shape}"
+        )
+    return mask.copy()

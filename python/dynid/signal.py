@@ -16,14 +16,13 @@ Every function works along ``axis`` (default 0, the time axis of a (T, n) trajec
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import signal as _sp
-from scipy.ndimage import median_filter
 
 from ._checks import is_integer, positive, positive_int, real_array
+from ._iir import PadType, butterworth_lowpass, default_padding, zero_phase
 
 #: Anti-aliasing cutoff of :func:`decimate` as a fraction of the new Nyquist frequency (the value
 #: scipy.signal.decimate uses): the band kept is undistorted, the band folded back is attenuated.
@@ -71,10 +70,6 @@ def _per_column(value: ArrayLike, name: str, columns: int, what: str) -> NDArray
     return array
 
 
-#: How scipy.signal.sosfiltfilt extends the signal at the ends.
-PadType = Literal["odd", "even", "constant"]
-
-
 def _sosfiltfilt(
     x: NDArray,
     sos: NDArray,
@@ -84,11 +79,10 @@ def _sosfiltfilt(
     padtype: PadType = "odd",
     padlen: int | None = None,
 ) -> NDArray:
-    """sosfiltfilt with a readable error when x is shorter than the filter's edge padding."""
+    """Zero-phase filtering along ``axis`` (scipy.signal.sosfiltfilt's, :mod:`dynid._iir`) with
+    a readable error when x is shorter than the filter's edge padding."""
     if padlen is None:
-        # Same default padding as scipy.signal.sosfiltfilt: 3 * (2 * sections + 1 - trailing zeros).
-        zeros = min(int((sos[:, 2] == 0).sum()), int((sos[:, 5] == 0).sum()))
-        padlen = 3 * (2 * len(sos) + 1 - zeros)
+        padlen = default_padding(sos)
     if padtype not in ("odd", "even", "constant"):
         raise ValueError(f"padtype: expected 'odd', 'even' or 'constant', got {padtype!r}")
     if x.shape[axis] <= padlen:
@@ -97,7 +91,10 @@ def _sosfiltfilt(
             f"zero-phase filter, which extends the signal by {padlen} samples at each end; "
             f"need at least {padlen + 1}"
         )
-    return _sp.sosfiltfilt(sos, x, axis=axis, padtype=padtype, padlen=padlen)
+    columns = np.moveaxis(x, axis, 0)
+    shape = columns.shape
+    filtered = zero_phase(sos, columns.reshape(shape[0], -1), padtype, padlen)
+    return np.moveaxis(filtered.reshape(shape), 0, axis)
 
 
 # --------------------------------------------------------------------------- filtering
@@ -149,7 +146,7 @@ def lowpass(
         raise ValueError(
             f"cutoff: expected 0 < cutoff < fs/2 = {fs / 2:g} Hz (Nyquist), got {cutoff:g} Hz"
         )
-    sos = _sp.butter(order, cutoff, btype="low", fs=fs, output="sos")
+    sos = butterworth_lowpass(order, 2.0 * cutoff / fs)
     padlen = min(int(3 * fs / cutoff), arr.shape[ax] - 1) if settle else None
     return _sosfiltfilt(arr, sos, ax, order, "x", padtype=padtype, padlen=padlen)
 
@@ -262,7 +259,7 @@ def decimate(*data: Any, factor: int | None = None, order: int = 8, antialias: b
         if factor == 1:
             return arr.copy()
         if antialias:
-            sos = _sp.butter(order, wn, btype="low", output="sos")
+            sos = butterworth_lowpass(order, wn)
             arr = _sosfiltfilt(arr, sos, 0, order, name)
         return np.ascontiguousarray(arr[::factor])
 
@@ -381,6 +378,10 @@ def spike_mask(
     if window < 5 or window % 2 == 0:
         raise ValueError(f"window: expected an odd number of samples >= 5, got {window}")
     iterations = positive_int(iterations, "iterations")
+    # SciPy's signal and ndimage cost ~0.5 s to import: only when spikes are looked for.
+    from scipy.ndimage import median_filter
+    from scipy.signal import savgol_filter
+
     columns = arr.reshape(arr.shape[0], -1)
     if columns.shape[0] < window:
         raise ValueError(f"x: {columns.shape[0]} samples are fewer than the window of {window}")
@@ -391,7 +392,7 @@ def spike_mask(
     for _ in range(iterations):
         cleaned = np.where(mask, smoothed, columns)
         despiked = median_filter(cleaned, size=(5, 1), mode="nearest")
-        smoothed = _sp.savgol_filter(despiked, window, 3, axis=0, mode="interp")
+        smoothed = savgol_filter(despiked, window, 3, axis=0, mode="interp")
         mask = outlier_mask(columns - smoothed, k, min_sigma=floor)
     if arr.ndim == 1:
         return mask[:, 0], smoothed[:, 0]

@@ -305,6 +305,26 @@ int main() {
   expect_close("RLS state finite", rls.is_finite() ? 0.0 : 1.0, 0.0);
   expect_close("model links consistent", model.link_inconsistency(0).empty() ? 0.0 : 1.0, 0.0);
 
+  // sos_filter: its state must match the sections and the signal's columns, every a0 be 1; a
+  // two-tap average y[t] = (x[t] + x[t-1]) / 2 from rest, and its state carried across blocks.
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  Rows average(1, 6), signal(5, 2), state = Rows::Zero(1, 4), bad_state = Rows::Zero(1, 3);
+  average << 0.5, 0.5, 0.0, 1.0, 0.0, 0.0;
+  signal << 1, 10, 2, 20, 3, 30, 4, 40, 5, 50;
+  Rows unnormalised = average;
+  unnormalised(0, 3) = 2.0;
+  expect_rejected("sos_filter", "state", [&] { dynid::sos_filter(average, signal, bad_state); });
+  expect_rejected("sos_filter", "sections",
+                  [&] { dynid::sos_filter(unnormalised, signal, state); });
+  Rows first = signal.topRows(2), rest = signal.bottomRows(3);
+  dynid::sos_filter(average, first, state);
+  dynid::sos_filter(average, rest, state);
+  Rows filtered(5, 2), expected(5, 2);
+  filtered << first, rest;
+  expected << 0.5, 5, 1.5, 15, 2.5, 25, 3.5, 35, 4.5, 45;
+  expect_close("sos_filter: two-tap average across blocks",
+               (filtered - expected).cwiseAbs().maxCoeff(), 0.0);
+
   std::printf("size checks: %d probes, %d failures\n", probes, failures);
   return failures == 0 ? 0 : 1;
 }

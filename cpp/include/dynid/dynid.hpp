@@ -22,5 +22,6 @@
 #include "dynid/rnea_derivatives.hpp"
 #include "dynid/rnea_time_derivatives.hpp"
 #include "dynid/simulator.hpp"
+#include "dynid/sos_filter.hpp"
 #include "dynid/types.hpp"
 #include "dynid/workspace.hpp"

@@ -41,7 +41,13 @@ def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
 def demo(args: argparse.Namespace) -> None:
     from ..demo import run_demo
 
-    run_demo(args.output, train=args.train, validation=args.validation, seed=args.seed)
+    run_demo(
+        args.output,
+        train=args.train,
+        validation=args.validation,
+        seed=args.seed,
+        overwrite=args.overwrite,
+    )
 
 
 def identify(args: argparse.Namespace) -> None:
@@ -54,6 +60,8 @@ def identify(args: argparse.Namespace) -> None:
     check_output_path(args.output, args.overwrite)  # before the work, not after
     if not args.physical and (args.prior is not None or args.prior_weight is not None):
         raise ValueError("--prior, --prior-weight: only with --physical")
+    if args.friction and args.asymmetric_friction:
+        raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
     step(
@@ -66,7 +74,7 @@ def identify(args: argparse.Namespace) -> None:
         log,
         robot,
         rotor=args.rotor,
-        friction=args.friction,
+        friction="asymmetric" if args.asymmetric_friction else args.friction,
         offset=args.offset,
         method=args.method,
         preparation=preparation_options(args),

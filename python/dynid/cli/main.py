@@ -8,7 +8,7 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
-from ..physical import PhysicalIdentificationError
+from ..errors import PhysicalIdentificationError
 from .parsers import build_parser
 
 #: Exit status for bad input (missing file, malformed log, model or result), as argparse's.

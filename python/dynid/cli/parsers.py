@@ -20,7 +20,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo = subcommands.add_parser(
         "demo", help="the KUKA LWR-IV identification of Gaz et al. (ICRA 2014) on a simulated arm"
     )
-    demo.add_argument("--output", default="dynid-demo", help="output folder (default ./dynid-demo)")
+    _add_output(demo, "dynid-demo")
     demo.add_argument("--train", type=int, default=1000, help="training configurations")
     demo.add_argument("--validation", type=int, default=200, help="validation configurations")
     demo.add_argument("--seed", type=int, default=0)
@@ -48,6 +48,13 @@ def _add_identify(subcommands: Any) -> None:
     p.add_argument("--rotor", action="store_true", help="add the rotor inertia columns Ia")
     p.add_argument(
         "--friction", action="store_true", help="add viscous and Coulomb friction columns Fv, Fs"
+    )
+    p.add_argument(
+        "--asymmetric-friction",
+        action="store_true",
+        help="friction with one coefficient per direction of motion, Fv+, Fv-, Fs+, Fs- "
+        "(with --offset: Fv+, Fv-, Fs, the offset holding the Coulomb asymmetry), instead of "
+        "--friction's Fv, Fs (docs/identification.md)",
     )
     p.add_argument(
         "--offset", action="store_true", help="add a constant torque (sensor offset) per joint"

@@ -11,6 +11,7 @@ disk, a plot that cannot be drawn) leaves the previous folder as it was.
 from __future__ import annotations
 
 import os
+import secrets
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -47,9 +48,7 @@ def output_folder(
     ``folder`` (see the module docstring); on an error it is removed and ``folder`` is untouched."""
     target = check_output_path(folder, overwrite, name)
     target.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(
-        tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent)
-    )
+    staging = _new_folder(target.parent, f".{target.name}.", ".partial")
     try:
         yield staging
     except BaseException:
@@ -64,6 +63,24 @@ def output_folder(
         shutil.rmtree(old, ignore_errors=True)
 
 
+def _new_folder(parent: Path, prefix: str, suffix: str) -> Path:
+    """A new, uniquely named folder in ``parent`` with the permissions of any new folder
+    (0o777 less the umask: tempfile.mkdtemp's 0o700 would make the results private)."""
+    while True:
+        path = parent / f"{prefix}{secrets.token_hex(4)}{suffix}"
+        try:
+            path.mkdir()
+        except FileExistsError:
+            continue
+        return path
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)  # the only way to read it is to set it: put it straight back
+    os.umask(mask)
+    return mask
+
+
 def write_text_atomic(path: PathLike, text: str) -> Path:
     """Write ``text`` to ``path`` through a temporary file in the same folder and a rename, so
     that ``path`` is either the old file or the complete new one, never a truncated mix."""
@@ -74,6 +91,8 @@ def write_text_atomic(path: PathLike, text: str) -> Path:
             stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())
+        # mkstemp makes the file private (0o600); the result gets a new file's permissions.
+        os.chmod(temporary, 0o666 & ~_umask())
         os.replace(temporary, target)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

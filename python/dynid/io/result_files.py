@@ -8,6 +8,9 @@ and the training log's preparation and per-joint fit. Non-finite numbers (a rela
 deviation of a coefficient that is exactly 0) are written as null. A physically consistent
 result (``identify_log(physical=True)``) also holds the identified parameters in ``model`` and
 the solver's report in ``physical``; ``load_result(...).robot`` is then the identified robot.
+``options.friction`` says whether the symmetric friction columns Fv, Fs are regressor columns
+(``base_parameters.parameter_names``), ``options.friction_model`` which friction model the
+result has ("none", "symmetric", "asymmetric"; :mod:`dynid.friction_models`).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._version import dynid_version
+from ..friction_models import FRICTION_MODELS, asymmetric_count
 from ..log_identification import LogIdentification, LogValidation
 from ..robot import Robot
 from .log_files import Log
@@ -29,8 +33,13 @@ from .output_folder import output_folder
 PathLike = Union[str, Path]
 
 FORMAT = "dynid-identification"
-#: Format version written; the loader reads versions 1 (no covariance) to VERSION.
-VERSION = 2
+#: Newest format version; the loader reads versions 1 (no covariance) to VERSION. A result is
+#: written with the lowest version that holds it, so that an older dynid reads every result it
+#: can apply and refuses, naming the version, the others: 2 (covariance, position torque) unless
+#: it has asymmetric friction (``options.friction_model``, version 3).
+VERSION = 3
+#: The version of results without asymmetric friction.
+VERSION_SYMMETRIC = 2
 #: Units of what a result holds (written into result.json for readers other than dynid).
 UNITS = {
     "length": "m",
@@ -42,6 +51,8 @@ UNITS = {
 }
 RESULT_FILE = "result.json"
 VALIDATION_FORMAT = "dynid-validation"
+#: Format version of validation.json (unchanged by the result's version 3).
+VALIDATION_VERSION = 2
 VALIDATION_FILE = "validation.json"
 
 
@@ -77,7 +88,7 @@ def save_validation(
     ``plots``, the torque and residual plots of the validation log; returns the JSON path."""
     report = {
         "format": VALIDATION_FORMAT,
-        "version": VERSION,
+        "version": VALIDATION_VERSION,
         "dynid_version": dynid_version(),
         "result": result_source,
         "log": log_source,
@@ -154,13 +165,14 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
     data = {
         "format": FORMAT,
-        "version": VERSION,
+        "version": VERSION if result.asymmetric_friction else VERSION_SYMMETRIC,
         "dynid_version": dynid_version(),
         "units": UNITS,
         "model": result.model,
         "options": {
             "rotor": result.rotor,
             "friction": result.friction,
+            "friction_model": result.friction_model,
             "offset": result.offset,
             "method": result.method,
             "exclude_joints": list(result.excluded),
@@ -227,7 +239,9 @@ def result_from_dict(data: Any) -> LogIdentification:
             f"base_parameters.beta: expected shape {(count, len(expected))}, got {beta.shape}"
         )
     position_joints = _position_joints(options.get("position_torque_joints", []), robot.n)
+    asymmetric = _asymmetric_friction(options.get("friction_model"), flags["friction"])
     p = count + (robot.n if flags["offset"] else 0) + 2 * len(position_joints)
+    p += asymmetric_count(robot.n, flags["offset"]) if asymmetric else 0
     rows = _get(data, "coefficients")
     if not isinstance(rows, list) or len(rows) != p:
         raise ValueError(f"coefficients: expected a list of {p} entries")
@@ -275,8 +289,24 @@ def result_from_dict(data: Any) -> LogIdentification:
         covariance=_covariance(data.get("covariance"), p),
         physical=physical,
         position_joints=position_joints,
+        asymmetric_friction=asymmetric,
         _robot=robot,
     )
+
+
+def _asymmetric_friction(model: Any, friction: bool) -> bool:
+    """options.friction_model (absent before format version 3: from options.friction, which
+    says whether the symmetric Fv, Fs are regressor columns): whether the result has the
+    asymmetric friction columns."""
+    if model is None:
+        return False
+    expected = {"none": False, "symmetric": True, "asymmetric": False}
+    if model not in expected or expected[model] != friction:
+        raise ValueError(
+            f"options.friction_model: expected {', '.join(map(repr, FRICTION_MODELS))} "
+            f"matching options.friction = {str(friction).lower()}, got {model!r}"
+        )
+    return bool(model == "asymmetric")
 
 
 def _position_joints(value: Any, n: int) -> tuple[int, ...]:
