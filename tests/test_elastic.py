@@ -298,8 +298,9 @@ def test_the_documented_example_runs() -> None:
 
 def test_no_heap_allocation_per_call(tmp_path):
     """Compiles tests/cpp/test_elastic_no_allocation.cpp with the core's sources and runs it: it
-    counts every operator new and malloc during 10^4 rnea_time_derivatives calls, checks tau
-    against rnea, and that size errors name the argument."""
+    counts every operator new and malloc during 10^4 rnea_time_derivatives calls and during
+    elastic simulator runs under MotorPD and the KUKA-like controller, checks tau against rnea,
+    and that size errors name the argument."""
     output = build_and_run(tmp_path, "test_elastic_no_allocation", optimisation="-O1")
     assert re.search(r"^allocations_during_calls=0$", output, re.MULTILINE), output
     print(output)

@@ -103,6 +103,15 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
         f"typing.Callable[[float, {ARRAY}, {ARRAY}, {ARRAY}, {ARRAY}, {ARRAY}], "
         f"{ARRAY_LIKE}] | None"
     ),
+    ("_simulate_elastic_kuka", "theta0"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "model_stiffness"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "kp"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "kd"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "torque_gain"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "torque_damping"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "q_d"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "qd_d"): ARRAY_LIKE,
+    ("_simulate_elastic_kuka", "tau_user"): f"{ARRAY_LIKE} | None",
 }
 
 # Property setters (their single argument is unnamed in pybind11), by property name.

@@ -587,16 +587,38 @@ def _simulate_elastic(
         numpy.typing.ArrayLike,
     ]
     | None,
-) -> tuple[
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-    numpy.typing.NDArray[numpy.float64],
-]:
+) -> tuple:
     """
     Closed-loop simulation of an elastic-joint robot (use dynid.sim.simulate_elastic): returns q, qd, theta, thetad, tau, tau_J, each (periods + 1, n).
+    """
+
+def _simulate_elastic_kuka(
+    links: Model,
+    stiffness: numpy.typing.ArrayLike,
+    motor_inertia: numpy.typing.ArrayLike,
+    motor_viscous: numpy.typing.ArrayLike,
+    motor_coulomb: numpy.typing.ArrayLike,
+    q0: numpy.typing.ArrayLike,
+    qd0: numpy.typing.ArrayLike,
+    theta0: numpy.typing.ArrayLike,
+    thetad0: numpy.typing.ArrayLike,
+    periods: typing.SupportsInt | typing.SupportsIndex,
+    dt: typing.SupportsFloat | typing.SupportsIndex,
+    substeps: typing.SupportsInt | typing.SupportsIndex,
+    coulomb_band: typing.SupportsFloat | typing.SupportsIndex,
+    model: Model,
+    model_stiffness: numpy.typing.ArrayLike,
+    kp: numpy.typing.ArrayLike,
+    kd: numpy.typing.ArrayLike,
+    torque_gain: numpy.typing.ArrayLike,
+    torque_damping: numpy.typing.ArrayLike,
+    gravity: str,
+    q_d: numpy.typing.ArrayLike,
+    qd_d: numpy.typing.ArrayLike,
+    tau_user: numpy.typing.ArrayLike | None,
+) -> tuple:
+    """
+    Elastic-joint simulation under the KUKA-like joint torque controller (use dynid.sim.simulate_elastic with dynid.sim.KukaLike): returns q, qd, theta, thetad, tau, tau_J, each (periods + 1, n).
     """
 
 def _sincos(

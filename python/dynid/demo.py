@@ -31,7 +31,7 @@ from .from_controller import IdentifiedModel, identify_from_controller, payload_
 from .io.output_folder import check_output_path, output_folder
 from .robot import Robot
 from .signal import differentiate, lowpass
-from .sim import StaticReadings, VirtualController, paper_validation_trajectory
+from .sim import StaticReadings, TorqueRecording, VirtualController, paper_validation_trajectory
 from .validation import error_metrics, paper_table
 
 #: Fewest training configurations `dynid demo` accepts. The LWR-IV's 12 gravity coefficients are
@@ -115,7 +115,14 @@ def run_demo(
         "torque_noise": torque_noise,
         "position_noise": position_noise,
     }
-    controller = VirtualController(truth, seed=seed, link_friction=link_friction, **noise)
+    controller = VirtualController(
+        truth,
+        seed=seed,
+        link_friction=link_friction,
+        model_noise=model_noise,
+        torque_noise=torque_noise,
+        position_noise=position_noise,
+    )
     training = controller.read_static(controller.random_configurations(train))
     checking = controller.read_static(controller.random_configurations(validation))
     step(
@@ -146,19 +153,7 @@ def run_demo(
 
     # 4. The torque validation experiment, eq. (33), tracked in closed loop.
     recording = controller.track(lambda t: paper_validation_trajectory(t, truth.n), 14.0, 1000.0)
-    fs = 1000.0
-
-    def smooth(x: np.ndarray) -> np.ndarray:
-        # The motion starts and ends at rest, so the signals are extended evenly at both ends.
-        return lowpass(x, fs, 1.0, order=4, padtype="even", settle=True)
-
-    # Filtering q before differentiating equals the paper's differentiate-then-filter (the two
-    # commute) except at the ends, where it avoids filtering from a noisy end value.
-    q = smooth(recording.q)
-    qd = differentiate(q, fs=fs)
-    qdd = differentiate(qd, fs=fs)
-    tau = smooth(recording.tau)
-    tau_hat = ident.rnea(q, qd, qdd)
+    q, qd, qdd, tau, tau_hat = torque_validation(recording, ident)
     tve = error_metrics(tau, tau_hat)
     tracking = np.abs(recording.motion.q - recording.q_desired).max(axis=0)
     step(4, "torque validation experiment q_des(t) = pi/2 cos(pi t / 7), T = 14 s")
@@ -188,7 +183,11 @@ def run_demo(
 
     # 5. A second arm with the 250 g tip.
     tip_controller = VirtualController(
-        truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA), seed=seed + 1, **noise
+        truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA),
+        seed=seed + 1,
+        model_noise=model_noise,
+        torque_noise=torque_noise,
+        position_noise=position_noise,
     )
     tip = tip_controller.read_static(tip_controller.random_configurations(train))
     tip_ident = identify_from_controller(structure, tip.q, tip.g, tip.M)
@@ -257,6 +256,26 @@ def run_demo(
         (staging / "demo.json").write_text(json.dumps(report, indent=1))
     step(6, f"wrote {Path(output) / 'demo.json'} and {len(files)} plots")
     return report
+
+
+def torque_validation(
+    recording: TorqueRecording, ident: IdentifiedModel, fs: float = 1000.0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The torque validation of paper eq. (33) on a recording at ``fs`` Hz: (q, qd, qdd, tau,
+    tau_hat), the filtered positions and their derivatives, the filtered measured tau_J and the
+    identified model's torques ``ident.rnea(q, qd, qdd)``."""
+
+    def smooth(x: np.ndarray) -> np.ndarray:
+        # The motion starts and ends at rest, so the signals are extended evenly at both ends.
+        return lowpass(x, fs, 1.0, order=4, padtype="even", settle=True)
+
+    # Filtering q before differentiating equals the paper's differentiate-then-filter (the two
+    # commute) except at the ends, where it avoids filtering from a noisy end value.
+    q = smooth(recording.q)
+    qd = differentiate(q, fs=fs)
+    qdd = differentiate(qd, fs=fs)
+    tau = smooth(recording.tau)
+    return q, qd, qdd, tau, ident.rnea(q, qd, qdd)
 
 
 def _coefficient_table(ident: IdentifiedModel) -> str:

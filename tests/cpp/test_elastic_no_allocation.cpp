@@ -1,10 +1,10 @@
 // Proof that rnea_time_derivatives (the jerk/snap Newton-Euler recursion behind ElasticRobot's
 // inverse dynamics) never touches the heap per call, nor does a run of the ElasticSimulator under
-// the built-in motor PD (500 periods, 5 RK4 substeps): 10^4 calls on a 7-joint arm (standard DH,
-// one prismatic joint, base, tool, drive terms) with every operator new and (on glibc) malloc
-// counted (cpp/examples/allocation_counter.hpp). Also checks that a badly sized argument is a
-// std::invalid_argument whose message starts with the argument's name.
-// Exit status 1 on an allocation, 2 on a missing or wrong error, 3 if the counters miss a probe.
+// the built-in motor PD or the KUKA-like controller (500 periods, 5 RK4 substeps): 10^4 calls on a
+// 7-joint arm (standard DH, one prismatic joint, base, tool, drive terms) with every operator new
+// and (on glibc) malloc counted (cpp/examples/allocation_counter.hpp). Also checks that a badly
+// sized argument is a std::invalid_argument whose message starts with the argument's name. Exit
+// status 1 on an allocation, 2 on a missing or wrong error, 3 if the counters miss a probe.
 //
 // Build (tests/test_elastic.py does this and runs it):
 //   g++ -O1 -std=c++17 -I cpp/include -I cpp/examples -I <eigen3>
@@ -126,6 +126,26 @@ int main() {
   simulator.run(pd, zero, zero, zero, zero, periods, out);
   counting = false;
   sink += blocks[0](periods, 0);
+
+  // The same run under the KUKA-like controller (static gravity: a fixed-point iteration of
+  // gravity() per command, torque loop, a user torque), constructed outside the count.
+  std::vector<double> ref_q((periods + 1) * n), ref_qd((periods + 1) * n), user((periods + 1) * n);
+  for (int k = 0; k <= periods; ++k)
+    for (int i = 0; i < n; ++i) {
+      ref_q[k * n + i] = 0.2 + 0.1 * std::sin(1e-3 * k + i);
+      ref_qd[k * n + i] = 0.1e-3 * std::cos(1e-3 * k + i);
+      user[k * n + i] = 0.1 * i;
+    }
+  const dynid::ReferenceTrajectory reference{ref_q.data(), ref_qd.data(), nullptr, periods + 1, n};
+  const dynid::KukaLikeGains gains{
+      dynid::VectorX::Constant(n, 300.0), dynid::VectorX::Constant(n, 30.0),
+      dynid::VectorX::Constant(n, 3.0), dynid::VectorX::Constant(n, 1e-3)};
+  dynid::KukaLikeController kuka(links, drives.stiffness, gains, dynid::GravityCompensation::Static,
+                                 reference, user.data());
+  counting = true;
+  simulator.run(kuka, zero, zero, zero, zero, periods, out);
+  counting = false;
+  sink += blocks[4](periods, n - 1);
   std::printf("allocations_during_calls=%ld\n", allocations);
   std::printf("max_abs_difference_to_rnea=%.3e\n", max_difference_to_rnea);
   if (allocations != 0 || !std::isfinite(sink)) return 1;
@@ -154,5 +174,18 @@ int main() {
   bad.stiffness[0] = 0.0;
   ok &= names_argument("stiffness", [&] { dynid::ElasticSimulator(links, bad, 1e-3, 5, 1e-3); });
   ok &= names_argument("substeps", [&] { dynid::ElasticSimulator(links, drives, 1e-3, 0, 1e-3); });
+  const auto kuka_with = [&](const dynid::VectorX& stiffness, const dynid::KukaLikeGains& g) {
+    dynid::KukaLikeController(links, stiffness, g, dynid::GravityCompensation::Desired, reference);
+  };
+  dynid::KukaLikeGains bad_gains = gains;
+  bad_gains.torque_gain[1] = -1.0;
+  ok &= names_argument("torque_gain", [&] { kuka_with(drives.stiffness, bad_gains); });
+  bad_gains = gains;
+  bad_gains.kd.resize(n - 1);
+  ok &= names_argument("kd", [&] { kuka_with(drives.stiffness, bad_gains); });
+  ok &= names_argument("stiffness", [&] { kuka_with(short_v, gains); });
+  dynid::VectorX tau_out(n);
+  ok &= names_argument("theta",
+                       [&] { kuka.command(0, 0.0, zero, zero, short_v, zero, zero, tau_out); });
   return ok ? 0 : 2;
 }

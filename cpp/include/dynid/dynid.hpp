@@ -13,6 +13,7 @@
 #include "dynid/gravity.hpp"
 #include "dynid/jacobian_dot.hpp"
 #include "dynid/kinematics.hpp"
+#include "dynid/kuka_like_controller.hpp"
 #include "dynid/model.hpp"
 #include "dynid/momentum_observer.hpp"
 #include "dynid/recursive_least_squares.hpp"

@@ -8,13 +8,14 @@
   measured q and joint torques along a motion tracked in closed loop):
   :mod:`~dynid.sim.virtual_controller`.
 - :func:`simulate_elastic` runs a robot with elastic joints (:class:`dynid.ElasticRobot`) the
-  same way (C++ RK4, zero-order hold; zero torque, :class:`MotorPD` or a Python controller):
+  same way (C++ RK4, zero-order hold; zero torque, :class:`MotorPD`, the KUKA-like joint torque
+  controller :class:`KukaLike` or a Python controller):
   :mod:`~dynid.sim.elastic_joints`.
 """
 
 from .closed_loop import Simulation, plant_friction, simulate
 from .controllers import PD, ComputedTorque, PDGravity
-from .elastic_joints import ElasticSimulation, MotorPD, simulate_elastic
+from .elastic_joints import ElasticSimulation, KukaLike, MotorPD, simulate_elastic
 from .virtual_controller import (
     StaticReadings,
     TorqueRecording,
@@ -26,6 +27,7 @@ __all__ = [
     "PD",
     "ComputedTorque",
     "ElasticSimulation",
+    "KukaLike",
     "MotorPD",
     "PDGravity",
     "Simulation",

@@ -23,6 +23,13 @@ plus the sensor's noise. Unlike a perfectly tracked motion, this shows what the 
 validation shows on the real robot: a tracking error, measured positions that are not the
 desired ones, and torque errors of the identified model, which has no friction, of a few tenths
 of a N m at the joints with the largest friction.
+
+With ``elastic=`` a :class:`~dynid.ElasticRobot`, :meth:`VirtualController.track` simulates the
+elastic joints instead (paper eqs. (1)-(3), :func:`dynid.sim.simulate_elastic`) under the
+KUKA-like joint torque controller (:class:`dynid.sim.KukaLike`: motor-side impedance law with
+the controller's gravity, inner torque loop of gain ``torque_gain``) run at
+:data:`TORQUE_LOOP_FACTOR` times the recording rate, and tau_J is the spring torque
+K (theta - q) plus the sensor's noise: what GetMeasuredJointTorques returns.
 """
 
 from __future__ import annotations
@@ -35,10 +42,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
 from .._checks import real_array
+from ..elastic import ElasticRobot
 from ..robot import Robot
 from .closed_loop import Simulation, plant_friction, simulate
 from .controllers import PDGravity, sample_reference
 from .controllers import gains as check_gains
+from .elastic_joints import ElasticSimulation, KukaLike, simulate_elastic
 
 Trajectory = Callable[[NDArray[np.float64]], tuple[NDArray, NDArray, NDArray]]
 
@@ -60,7 +69,9 @@ class TorqueRecording:
     q: NDArray[np.float64]  #: (T, n) measured link positions
     tau: NDArray[np.float64]  #: (T, n) measured elastic joint torques tau_J
     q_desired: NDArray[np.float64]  #: (T, n) the commanded positions
-    motion: Simulation  #: the closed-loop run: true q, qd, qdd and the commanded torques
+    #: the closed-loop run (true q, qd, the commanded torques; an ElasticSimulation with theta,
+    #: thetad, tau_J at the recording rate when the joints are elastic)
+    motion: Simulation | ElasticSimulation
 
 
 #: Closed-loop bandwidth [rad/s] of the default position controller: each joint's PD gains put
@@ -68,6 +79,18 @@ class TorqueRecording:
 TRACKING_BANDWIDTH = 30.0
 #: Coulomb smoothing band [rad/s] of the simulated plant (dynid.sim.simulate's coulomb_band).
 COULOMB_BAND = 1e-3
+#: Default gain K_T of the KUKA-like controller's torque loop (elastic joints): the motor inertia
+#: seen by the impedance law is B / (1 + K_T).
+KUKA_TORQUE_GAIN = 3.0
+#: Default D_T [s] of the torque loop: the torque-derivative feedback -D_T tau_J' damps the joints'
+#: own vibration, which the sampled torque loop excites (without it K_T = 3 diverges on the LWR's
+#: wrist at 3 kHz; docs/elastic.md).
+KUKA_TORQUE_DAMPING = 1e-3
+#: The elastic joints' controller runs this many times faster than the recording (the KR C2's
+#: joint controllers run at 3 kHz under the FRI's 1 kHz): it keeps the sampled torque loop stable.
+TORQUE_LOOP_FACTOR = 3
+#: Largest RK4 step, as a fraction of the period of the fastest spring oscillation.
+SPRING_STEP = 0.05
 
 
 class VirtualController:
@@ -96,6 +119,15 @@ class VirtualController:
         controller and in the recorded q (None: exact).
     seed
         Seed of the random generator (configurations and noise).
+    elastic
+        None (rigid joints), or the elastic-joint plant (:class:`~dynid.ElasticRobot`, same joint
+        count) that :meth:`track` simulates under the KUKA-like controller; its stiffness is the
+        controller's too. Needs ``link_friction=0`` (the elastic plant's friction is on the motor
+        side, outside tau_J). ``encoder_counts`` then quantises the recorded q only (the
+        controller uses the motor positions).
+    torque_gain, torque_damping
+        K_T and D_T of the KUKA-like torque loop (a number or one per joint, >= 0), elastic
+        joints only.
     """
 
     def __init__(
@@ -108,6 +140,9 @@ class VirtualController:
         link_friction: ArrayLike = 0.0,
         encoder_counts: float | None = None,
         seed: int | None = 0,
+        elastic: ElasticRobot | None = None,
+        torque_gain: ArrayLike = KUKA_TORQUE_GAIN,
+        torque_damping: ArrayLike = KUKA_TORQUE_DAMPING,
     ) -> None:
         checks.robot(robot)
         for name, value in (
@@ -129,6 +164,20 @@ class VirtualController:
             raise ValueError(
                 f"encoder_counts: expected a positive count or None, got {encoder_counts!r}"
             )
+        if elastic is not None:
+            if not isinstance(elastic, ElasticRobot) or elastic.n != robot.n:
+                raise ValueError(
+                    f"elastic: expected None or a dynid.ElasticRobot with {robot.n} joints, got "
+                    f"{elastic!r}"
+                )
+            if np.any(fraction != 0.0):
+                raise ValueError(
+                    "link_friction: expected 0 with elastic joints (their friction acts on the "
+                    f"motor side, outside tau_J), got {link_friction!r}"
+                )
+        self.elastic = elastic
+        self.torque_gain = check_gains(torque_gain, "torque_gain", robot.n)
+        self.torque_damping = check_gains(torque_damping, "torque_damping", robot.n)
         self.plant = robot.copy()
         self.robot = robot.rigid_body()
         self.model_noise = float(model_noise)
@@ -181,6 +230,8 @@ class VirtualController:
         periods = max(round(duration * rate), 1)
         t = np.arange(periods + 1) / rate
         q_d, qd_d, qdd_d = sample_reference(trajectory, t, self.robot.n, "trajectory")
+        if self.elastic is not None:
+            return self._track_elastic(trajectory, periods, rate, gains, substeps)
         if gains is None:
             inertia = np.diag(self.plant.mass_matrix(q_d[0]))
             kp, kd = TRACKING_BANDWIDTH**2 * inertia, 2.0 * TRACKING_BANDWIDTH * inertia
@@ -210,6 +261,83 @@ class VirtualController:
         return TorqueRecording(
             t=t, q=self._measure_position(run.q_measured), tau=tau, q_desired=q_d, motion=run
         )
+
+    def _track_elastic(
+        self,
+        trajectory: Trajectory,
+        periods: int,
+        rate: float,
+        gains: tuple[ArrayLike, ArrayLike] | None,
+        substeps: int | None,
+    ) -> TorqueRecording:
+        """track() on the elastic plant: the KUKA-like controller at TORQUE_LOOP_FACTOR * rate,
+        recorded at ``rate``; tau_J = K (theta - q) plus the sensor noise."""
+        elastic = self.elastic
+        assert elastic is not None
+        n, factor = elastic.n, TORQUE_LOOP_FACTOR
+        dt = 1.0 / (rate * factor)
+        t_fine = np.asarray(np.arange(periods * factor + 1) * dt, dtype=np.float64)
+        q_d, qd_d, qdd_d = sample_reference(trajectory, t_fine, n, "trajectory")
+        # The inertia the impedance law moves: the links' and the shaped motor's, B / (1 + K_T).
+        inertia = np.diag(elastic.link.mass_matrix(q_d[0])) + elastic.B / (1.0 + self.torque_gain)
+        kp, kd = self._gains(gains, inertia)
+        if substeps is None:
+            substeps = elastic_substeps(
+                elastic, q_d[0], dt, COULOMB_BAND, self.torque_gain, kd, self.torque_damping
+            )
+        run = simulate_elastic(
+            elastic,
+            q_d[0],
+            None,  # the springs start at the static deflection of q_d(0)
+            qd_d[0],
+            qd_d[0],
+            periods * factor * dt,
+            KukaLike(
+                elastic,
+                kp,
+                kd,
+                (q_d, qd_d, qdd_d),
+                torque_gain=self.torque_gain,
+                torque_damping=self.torque_damping,
+            ),
+            dt=dt,
+            substeps=substeps,
+            coulomb_band=COULOMB_BAND,
+        )
+        keep = slice(None, None, factor)
+        motion = ElasticSimulation(
+            *(
+                getattr(run, name)[keep]
+                for name in ("t", "q", "qd", "theta", "thetad", "tau", "tau_J")
+            )
+        )
+        tau = motion.tau_J
+        if self.torque_noise > 0.0:
+            tau = tau + self.torque_noise * self.rng.standard_normal(tau.shape)
+        q = motion.q
+        if self.encoder_counts is not None:
+            # As dynid.sim.simulate: 2 pi / counts rad (revolute), 1 / counts m (prismatic).
+            revolute = np.array([kind == "R" for kind in self.robot.joint_types])
+            step = np.where(revolute, 2.0 * np.pi, 1.0) / float(self.encoder_counts)
+            q = step * np.round(q / step)
+        return TorqueRecording(
+            t=motion.t,
+            q=self._measure_position(q),
+            tau=tau,
+            q_desired=q_d[keep],
+            motion=motion,
+        )
+
+    def _gains(
+        self, gains: tuple[ArrayLike, ArrayLike] | None, inertia: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(kp, kd): the given ones, checked, or critically damped ones of bandwidth
+        TRACKING_BANDWIDTH for ``inertia``."""
+        if gains is None:
+            return TRACKING_BANDWIDTH**2 * inertia, 2.0 * TRACKING_BANDWIDTH * inertia
+        if not (isinstance(gains, tuple) and len(gains) == 2):
+            raise ValueError(f"gains: expected a tuple (kp, kd), got {gains!r}")
+        return check_gains(gains[0], "kp", self.robot.n), check_gains(gains[1], "kd", self.robot.n)
 
     def _model_error(self, values: NDArray[np.float64]) -> NDArray[np.float64]:
         if self.model_noise == 0.0:
@@ -249,6 +377,39 @@ def stable_substeps(
     scaled = np.linalg.solve(L, np.linalg.solve(L, damping).T)  # L^-1 D L^-T
     rate = float(np.linalg.eigvalsh(0.5 * (scaled + scaled.T))[-1])
     return max(1, int(np.ceil(dt * rate / 2.0)))
+
+
+def elastic_substeps(
+    elastic: ElasticRobot,
+    q: ArrayLike,
+    dt: float,
+    coulomb_band: float,
+    torque_gain: ArrayLike = 0.0,
+    kd: ArrayLike = 0.0,
+    torque_damping: ArrayLike = 0.0,
+) -> int:
+    """RK4 steps per control period dt of an elastic run under :class:`KukaLike`: the step
+    resolves the fastest spring oscillation (a :data:`SPRING_STEP` of its period, motors of the
+    shaped inertia B / (1 + K_T)) and the motor damping near rest (Kd through the torque loop,
+    the friction band, D_T K; rate * h <= 2 as in :func:`stable_substeps`)."""
+    gain = 1.0 + np.asarray(torque_gain, dtype=float)
+    # Undamped links and motors on the springs, shaped motor inertia: the largest frequency.
+    n = elastic.n
+    K = np.diag(elastic.K)
+    mass = np.zeros((2 * n, 2 * n))
+    mass[:n, :n] = elastic.link.mass_matrix(q)
+    mass[n:, n:] = np.diag(elastic.B / gain)
+    stiffness = np.block([[K, -K], [-K, K]])
+    L = np.linalg.cholesky(mass)
+    scaled = np.linalg.solve(L, np.linalg.solve(L, stiffness).T)  # L^-1 S L^-T
+    omega = float(np.sqrt(max(np.linalg.eigvalsh(0.5 * (scaled + scaled.T))[-1], 0.0)))
+    spring = dt * omega / (2.0 * np.pi * SPRING_STEP)
+    # Motor equation near rest: B thetadd = -((1 + K_T) Kd + Fv_m + Fs_m / band + D_T K) thetad.
+    friction = elastic.Fv_m + elastic.Fs_m / coulomb_band
+    damping = np.asarray(kd, dtype=float) * gain + friction
+    damping = damping + np.asarray(torque_damping, dtype=float) * elastic.K
+    motor = dt * float(np.max(damping / elastic.B)) / 2.0
+    return max(1, int(np.ceil(max(spring, motor))))
 
 
 def paper_validation_trajectory(
