@@ -83,6 +83,15 @@ def test_to_urdf_refuses_coupled_drives_and_rigid_body_drops_them() -> None:
     np.testing.assert_array_equal(links.mass_matrix(q), expected)
 
 
+def test_model_summary_shows_a_coupled_transmission() -> None:
+    from dynid.summary import model_summary
+
+    assert "transmission" not in model_summary(dynid.models.puma560())
+    text = model_summary(coupled_puma())
+    assert "transmission T (motor velocities T qd; Ia, Fv, Fs per motor):" in text
+    assert "   -0.15      0.3        1" in text  # the last row of the wrist block
+
+
 def test_with_payload_keeps_the_transmission() -> None:
     robot = coupled_puma()
     assert np.array_equal(robot.with_payload(1.0, [0, 0, 0.1]).transmission, robot.transmission)
