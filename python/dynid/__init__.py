@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from . import models
     from .bounds import DynamicBounds, dynamic_bounds
     from .cmake import get_cmake_dir, get_include
+    from .drive_gains import DriveGainIdentification, identify_drive_gains
     from .elastic import ElasticRobot
     from .elastic_identification import DriveIdentification, identify_drives
     from .errors import PhysicalIdentificationError
@@ -95,6 +96,8 @@ _LAZY = {
     "DynamicBounds": ".bounds",
     "ElasticRobot": ".elastic",
     "elastic": ".elastic",
+    "DriveGainIdentification": ".drive_gains",
+    "identify_drive_gains": ".drive_gains",
     "DriveIdentification": ".elastic_identification",
     "identify_drives": ".elastic_identification",
     "dynamic_bounds": ".bounds",
@@ -112,6 +115,7 @@ _LAZY = {
 # that it lists every name of _LAZY.
 __all__ = [
     "BaseParameters",
+    "DriveGainIdentification",
     "DriveIdentification",
     "DynamicBounds",
     "ElasticRobot",
@@ -138,6 +142,7 @@ __all__ = [
     "get_cmake_dir",
     "get_include",
     "get_threads",
+    "identify_drive_gains",
     "identify_drives",
     "identify_from_controller",
     "identify_log",

@@ -128,6 +128,10 @@ class LogIdentification(ValueEquality):
     #: whether the asymmetric friction columns (Fv+, Fv-, Fs+, Fs-; Fs with offsets) are in
     #: ``theta`` after the base parameters (then ``friction`` is False)
     asymmetric_friction: bool = False
+    #: identified from motor currents (``dynid.identify_drive_gains``): the drive gains k
+    #: ("gains", "gains_std", tau = k * current), the payload that fixed their scale and the
+    #: runs; JSON-ready
+    drive_gains: dict[str, Any] | None = None
     #: the prepared training log (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
     _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
@@ -248,6 +252,9 @@ class LogIdentification(ValueEquality):
             f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}"
         )
         head = [model, fit]
+        if self.drive_gains is not None:  # identified from motor currents
+            gains = ", ".join(f"{k:.6g}" for k in self.drive_gains.get("gains", []))
+            head.append(f"drive gains k (tau = k * current): {gains}")
         if self.physical is not None:
             report = self.physical
             prior = (

@@ -58,6 +58,13 @@ def identify(args: argparse.Namespace) -> None:
     from ..log_identification import identify_log
 
     check_output_path(args.output, args.overwrite)  # before the work, not after
+    if args.current:
+        identify_from_currents(args)
+        return
+    if any(getattr(args, k) is not None for k in ("payload_log", "payload", "payload_mass")):
+        raise ValueError("--payload-log, --payload, --payload-mass: only with --current")
+    if args.method in ("nls", "tls"):
+        raise ValueError(f"--method {args.method}: only with --current (motor currents)")
     if not args.physical and (args.prior is not None or args.prior_weight is not None):
         raise ValueError("--prior, --prior-weight: only with --physical")
     if args.friction and args.asymmetric_friction:
@@ -76,7 +83,7 @@ def identify(args: argparse.Namespace) -> None:
         rotor=args.rotor,
         friction="asymmetric" if args.asymmetric_friction else args.friction,
         offset=args.offset,
-        method=args.method,
+        method=args.method or "wls",
         preparation=preparation_options(args),
         physical=args.physical,
         prior=args.prior,
@@ -87,6 +94,56 @@ def identify(args: argparse.Namespace) -> None:
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
     print(result.summary(), flush=True)
+    path = save_result(result, args.output, overwrite=args.overwrite)
+    step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def identify_from_currents(args: argparse.Namespace) -> None:
+    """``dynid identify --current``: drive gains and base parameters from motor currents."""
+    from ..drive_gains import identify_drive_gains
+    from ..io.log_files import load_log
+    from ..io.model_files import load_model
+    from ..io.payload_files import load_payload
+    from ..io.result_files import save_result
+
+    if args.physical or args.position_torque or args.prior is not None or args.asymmetric_friction:
+        raise ValueError(
+            "--current: not with --physical, --prior, --position-torque or --asymmetric-friction"
+        )
+    if args.payload_log is None:
+        raise ValueError(
+            "--current: needs --payload-log LOG, a run with a known payload: currents fix the "
+            "parameters and gains only up to a common scale, which the payload determines"
+        )
+    if (args.payload is None) == (args.payload_mass is None):
+        raise ValueError("--current: give exactly one of --payload FILE|NUMBERS, --payload-mass KG")
+    payload = load_payload(args.payload) if args.payload is not None else None
+    step = _steps(5)
+    log = load_log(args.log, **log_options(args))
+    loaded = load_log(args.payload_log, **log_options(args))
+    step(f"logs {args.log} ({log.T} samples), {args.payload_log} ({loaded.T} samples, loaded)")
+    robot = load_model(args.model)
+    step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
+    gains = identify_drive_gains(
+        robot,
+        log,
+        loaded,
+        payload=payload,
+        payload_mass=args.payload_mass,
+        rotor=args.rotor,
+        friction=args.friction,
+        offset=args.offset,
+        method=args.method or "nls",
+        preparation=preparation_options(args),
+    )
+    result = gains.result
+    new_notes = result.training["notes"][len(log.notes) :]
+    step("prepared: " + "; ".join(new_notes))
+    step(
+        f"identified {gains.gains.size} drive gains and {result.theta.size} coefficients on "
+        f"{sum(run['samples'] for run in gains.runs)} samples"
+    )
+    print(gains.summary(), flush=True)
     path = save_result(result, args.output, overwrite=args.overwrite)
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
 
@@ -102,6 +159,16 @@ def validate(args: argparse.Namespace) -> None:
     step = _steps(3)
     result = load_result(args.result)
     log = load_log(args.log, **log_options(args))
+    if args.current:
+        from ..drive_gains import torques_from_currents
+
+        log = torques_from_currents(result, log)
+    elif result.drive_gains is not None:
+        print(
+            "note: the result was identified from motor currents; pass --current if LOG "
+            "holds currents",
+            flush=True,
+        )
     validation = run_validation(result, log, preparation=preparation_options(args))
     step(
         f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "

@@ -68,9 +68,9 @@ def _add_identify(subcommands: Any) -> None:
     )
     p.add_argument(
         "--method",
-        choices=("ols", "wls"),
-        default="wls",
-        help="ordinary or weighted (per-joint noise) least squares (default wls)",
+        choices=("ols", "wls", "nls", "tls"),
+        help="ordinary or weighted (per-joint noise) least squares (default wls); with "
+        "--current also nls (the default there) or tls (docs/drive_gains.md)",
     )
     p.add_argument(
         "--physical",
@@ -90,6 +90,7 @@ def _add_identify(subcommands: Any) -> None:
         metavar="W",
         help="with --prior: its weight (default 1e-5, docs/identification.md)",
     )
+    _add_current(p)
     _add_preparation(p)
     p.add_argument(
         "--min-velocity",
@@ -113,6 +114,12 @@ def _add_validate(subcommands: Any) -> None:
     )
     p.add_argument("result", help="result folder of `dynid identify`, or its result.json")
     p.add_argument("log", help="measurement log, .npz or .csv")
+    p.add_argument(
+        "--current",
+        action="store_true",
+        help="LOG holds motor currents: converted to torques by the result's drive gains "
+        "(a result of `dynid identify --current`)",
+    )
     _add_preparation(p)
     _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
@@ -172,6 +179,36 @@ def _add_residual(subcommands: Any) -> None:
     _add_log_reading(p)
     _add_output(p, "dynid-residual")
     p.set_defaults(run=commands.residual)
+
+
+def _add_current(p: argparse.ArgumentParser) -> None:
+    """Drive gains from motor currents (commands.identify_from_currents)."""
+    p.add_argument(
+        "--current",
+        action="store_true",
+        help="LOG holds motor currents, not torques: identify the drive gains k "
+        "(tau = k * current) with the base parameters, the scale from a run with a known "
+        "payload (--payload-log with --payload or --payload-mass; docs/drive_gains.md)",
+    )
+    p.add_argument(
+        "--payload-log",
+        metavar="LOG",
+        help="with --current: a log (currents) of the arm carrying the payload on its last link",
+    )
+    p.add_argument(
+        "--payload",
+        metavar="FILE|NUMBERS",
+        help="with --current: the payload, a JSON/YAML file (mass, com, inertia about the com, "
+        "in the last DH frame; or parameters) or its 10 standard parameters "
+        "m,mx,my,mz,Ixx,Ixy,Ixz,Iyy,Iyz,Izz",
+    )
+    p.add_argument(
+        "--payload-mass",
+        type=float,
+        metavar="KG",
+        help="with --current, instead of --payload: the payload's mass alone (its centre of "
+        "mass and inertia are identified too)",
+    )
 
 
 def _add_model(p: argparse.ArgumentParser) -> None:

@@ -192,6 +192,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     }
     if result.physical is not None:
         data["physical"] = result.physical
+    if result.drive_gains is not None:
+        data["drive_gains"] = result.drive_gains
     return data
 
 
@@ -290,6 +292,7 @@ def result_from_dict(data: Any) -> LogIdentification:
         physical=physical,
         position_joints=position_joints,
         asymmetric_friction=asymmetric,
+        drive_gains=_drive_gains(data.get("drive_gains"), robot.n),
         _robot=robot,
     )
 
@@ -323,6 +326,18 @@ def _position_joints(value: Any, n: int) -> tuple[int, ...]:
             f"1..{n}, got {value!r}"
         )
     return tuple(j - 1 for j in value)
+
+
+def _drive_gains(value: Any, n: int) -> dict[str, Any] | None:
+    """drive_gains (results identified from motor currents; absent otherwise): an object whose
+    "gains" are n finite numbers."""
+    if value is None:
+        return None
+    report = _object(value, "drive_gains")
+    gains = _array(_get(report, "gains", "drive_gains"), "drive_gains.gains", 1)
+    if gains.size != n:
+        raise ValueError(f"drive_gains.gains: expected {n} gains, got {gains.size}")
+    return report
 
 
 def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
