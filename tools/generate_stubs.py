@@ -123,6 +123,7 @@ SETTER_TYPES: dict[str, str] = {
     "Ia": ARRAY_LIKE,
     "Fv": ARRAY_LIKE,
     "Fs": ARRAY_LIKE,
+    "transmission": f"{ARRAY_LIKE} | None",
     "forgetting": "float",
     "max_variance": "float | None",
 }

@@ -13,11 +13,12 @@
 
 namespace dynid::binding {
 
-// True when a batch of `s` should use the lane kernels.
+// True when a batch of `s` should use the lane kernels. Their drive terms are per joint (T = I),
+// so a model with a coupled transmission runs the scalar kernels (detail/drive_terms.hpp).
 inline bool use_lanes(const PyModel& self, const Samples& s,
                       int max_joints = detail::kMaxBatchJoints) {
   return !s.single && s.count > 0 && detail::batch_kernels() != nullptr &&
-         self.model->n() <= max_joints;
+         self.model->n() <= max_joints && self.model->transmission_is_identity();
 }
 
 // kernel(kernels, batch_model, inputs (each at sample `begin`), output at `begin`, count) returns

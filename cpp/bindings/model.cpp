@@ -205,6 +205,27 @@ void bind_model(py::module_& m) {
             self.modify([&](Model& model) { model.set_coulomb_friction(Fs); });
           },
           "Coulomb friction coefficients (n,).")
+      .def_property(
+          "transmission",
+          [](const PyModel& self) {
+            const RowMajorMatrixX T = self.model->transmission();
+            return read_only(T.data(), {self.model->n(), self.model->n()});
+          },
+          [](PyModel& self, py::handle value) {
+            const int n = self.model->n();
+            MatrixX T = MatrixX::Identity(n, n);
+            if (!value.is_none()) {
+              Array a = parse_fixed(value, "transmission", {n, n});
+              T = Eigen::Map<const RowMajorMatrixX>(a.data(), n, n);
+            }
+            // std::invalid_argument (shape, NaN, singular) reaches Python as a ValueError.
+            self.modify([&](Model& model) { model.set_transmission(T); });
+          },
+          "Transmission coupling T (n, n): motor velocities (after the gears) theta_dot = T qd "
+          "(notes p. 11-13). Identity (set None) is the decoupled model; otherwise Ia, Fv, Fs are "
+          "per motor and the drive torque is T^T (Ia T qdd + Fv T qd + Fs sign(T qd)). "
+          "ValueError naming transmission unless T is finite and invertible "
+          "(sigma_min / sigma_max > 1e-12).")
       .def(
           "_set_link_physical",
           [](PyModel& self, int i, double mass, py::handle com, py::handle inertia_com) {
@@ -237,14 +258,16 @@ void bind_model(py::module_& m) {
       [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, ConstVec qdd, double* tau) {
         rnea(m, ws, q, qd, qdd, OutVec(tau, m.n()));
       },
-      "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).",
+      "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler); with a "
+      "transmission T the friction is T^T (Fv T qd + Fs sign(T qd)).",
       &detail::LaneKernels::rnea);
   def_per_sample(
       model, "mass_matrix", {"q"}, joint_by_joint,
       [](const Model& m, Workspace& ws, ConstVec q, double* M) {
         crba(m, ws, q, row_major(M, m.n(), m.n()));
       },
-      "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).",
+      "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA); T^T diag(Ia) T with a "
+      "transmission T.",
       &detail::LaneKernels::mass_matrix);
   def_per_sample(
       model, "gravity", {"q"}, per_joint,
@@ -270,7 +293,7 @@ void bind_model(py::module_& m) {
       [](const Model& m, Workspace&, ConstVec qd, double* tau) {
         friction(m, qd, OutVec(tau, m.n()));
       },
-      "Joint friction Fv qd + Fs sign(qd).");
+      "Joint friction Fv qd + Fs sign(qd); T^T (Fv T qd + Fs sign(T qd)) with a transmission T.");
   // M(q) not positive definite (a std::domain_error) is a ValueError about the parameters.
   def_per_sample<DomainError::Params>(
       model, "forward_dynamics", {"q", "qd", "tau"}, per_joint,

@@ -10,6 +10,7 @@
 
 #include "dynid/detail/argument_checks.hpp"
 #include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
@@ -116,7 +117,7 @@ void crba(const Model& model, Workspace& workspace, const VectorIn& q, MatrixOut
   DYNID_CHECK_SHAPE(M, model.n(), model.n());
   detail::update_joint_transforms(model, ws, q);
   detail::composite_rigid_body(model, ws, M);
-  M.diagonal() += model.rotor_inertia();
+  detail::add_drive_inertia(model, M);
 }
 
 }  // namespace dynid

@@ -1,6 +1,7 @@
 #include "dynid/energy.hpp"
 
 #include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 
 namespace dynid {
@@ -14,6 +15,9 @@ double kinetic_energy(const Model& model, Workspace& workspace, const VectorIn& 
   const Vector3 z = Vector3::UnitZ();
   ws.omega[0].setZero();
   ws.v[0].setZero();
+  // Decoupled rotors are summed joint by joint as before the transmission existed; coupled ones
+  // spin at T qd (detail/drive_terms.hpp).
+  const bool decoupled = model.transmission_is_identity();
   double T = 0.0;
   for (int i = 1; i <= ws.n; ++i) {
     const detail::JointTransform& X = ws.X[i];
@@ -28,8 +32,9 @@ double kinetic_energy(const Model& model, Workspace& workspace, const VectorIn& 
     const Vector3& wi = ws.omega[i];
     const Vector3& vi = ws.v[i];
     T += 0.5 * (b.m * vi.squaredNorm() + wi.dot(b.I * wi)) + vi.dot(wi.cross(b.h));
-    T += 0.5 * model.rotor_inertia()[i - 1] * qd[i - 1] * qd[i - 1];
+    if (decoupled) T += 0.5 * model.rotor_inertia()[i - 1] * qd[i - 1] * qd[i - 1];
   }
+  if (!decoupled) T += detail::rotor_kinetic_energy(model, qd);
   return T;
 }
 

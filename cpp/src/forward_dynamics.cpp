@@ -6,7 +6,7 @@
 
 #include "dynid/detail/argument_checks.hpp"
 #include "dynid/detail/composite_rigid_body.hpp"
-#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/newton_euler.hpp"
 
@@ -22,9 +22,9 @@ void forward_dynamics(const Model& model, Workspace& workspace, const VectorIn& 
   // The bias c + g + friction: Newton-Euler with qdd = 0.
   detail::update_joint_transforms(model, ws, q);
   detail::newton_euler(model, ws, qd, ws.zeros, -model.gravity_base(), ws.bias);
-  for (int i = 0; i < ws.n; ++i) ws.bias[i] += detail::friction_torque(model, i, qd[i]);
+  detail::add_drive_friction(model, qd, ws.bias);
   detail::composite_rigid_body(model, ws, ws.M);
-  ws.M.diagonal() += model.rotor_inertia();
+  detail::add_drive_inertia(model, ws.M);
   ws.cholesky.compute(ws.M);
   if (ws.cholesky.info() != Eigen::Success)
     throw std::domain_error(

@@ -1,14 +1,15 @@
 #include "dynid/friction.hpp"
 
 #include "dynid/detail/argument_checks.hpp"
-#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/drive_terms.hpp"
 
 namespace dynid {
 
 void friction(const Model& model, const VectorIn& qd, VectorOut tau) {
   DYNID_CHECK_JOINT_VECTOR(qd, model);
   DYNID_CHECK_JOINT_VECTOR(tau, model);
-  for (int i = 0; i < model.n(); ++i) tau[i] = detail::friction_torque(model, i, qd[i]);
+  tau.setZero();
+  detail::add_drive_friction(model, qd, tau);
 }
 
 }  // namespace dynid

@@ -1,6 +1,7 @@
 #include "dynid/model.hpp"
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <cmath>
 #include <stdexcept>
 
@@ -49,6 +50,8 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   Ia_ = VectorX::Zero(n_);
   Fv_ = VectorX::Zero(n_);
   Fs_ = VectorX::Zero(n_);
+  T_ = MatrixX::Identity(n_, n_);
+  update_drive_matrices();
 
   // Bring both conventions to the modified form (joint_transform.hpp). For standard DH the
   // constant Tx(a_{i-1}) Rx(alpha_{i-1}) of the previous row precedes joint i, and link i's DH
@@ -138,14 +141,45 @@ std::string Model::link_inconsistency(int i) const {
 void Model::set_rotor_inertia(const VectorIn& Ia) {
   require_length(Ia, n_, "Ia");
   Ia_ = Ia;
+  update_drive_matrices();
 }
 void Model::set_viscous_friction(const VectorIn& Fv) {
   require_length(Fv, n_, "Fv");
   Fv_ = Fv;
+  update_drive_matrices();
 }
 void Model::set_coulomb_friction(const VectorIn& Fs) {
   require_length(Fs, n_, "Fs");
   Fs_ = Fs;
+}
+
+void Model::set_transmission(const Eigen::Ref<const MatrixX>& T) {
+  if (T.rows() != n_ || T.cols() != n_)
+    throw std::invalid_argument("transmission: expected shape (" + std::to_string(n_) + ", " +
+                                std::to_string(n_) + "), got (" + std::to_string(T.rows()) + ", " +
+                                std::to_string(T.cols()) + ")");
+  if (!T.allFinite()) throw std::invalid_argument("transmission: non-finite value");
+  // Invertible: every joint velocity follows from the motor velocities (q_dot = T^-1 theta_dot).
+  const VectorX sigma = Eigen::JacobiSVD<MatrixX>(T).singularValues();
+  const double rcond = sigma[0] > 0.0 ? sigma[n_ - 1] / sigma[0] : 0.0;
+  if (!(rcond > kTransmissionMinRcond))
+    throw std::invalid_argument(
+        "transmission: expected an invertible matrix (sigma_min / sigma_max > 1e-12), got "
+        "sigma_min / sigma_max = " +
+        std::to_string(rcond));
+  T_ = T;
+  transmission_identity_ = T_ == MatrixX::Identity(n_, n_);
+  update_drive_matrices();
+}
+
+void Model::update_drive_matrices() {
+  if (transmission_identity_) {
+    drive_inertia_ = Ia_.asDiagonal();
+    drive_damping_ = Fv_.asDiagonal();
+    return;
+  }
+  drive_inertia_ = T_.transpose() * Ia_.asDiagonal() * T_;
+  drive_damping_ = T_.transpose() * Fv_.asDiagonal() * T_;
 }
 
 void Model::update_bodies() {

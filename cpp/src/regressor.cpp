@@ -15,6 +15,7 @@
 #include <algorithm>
 
 #include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/newton_euler.hpp"
 
@@ -169,17 +170,36 @@ void regressor(const Model& model, Workspace& workspace, const VectorIn& q, cons
   detail::update_joint_transforms(model, ws, q);
   detail::propagate_motion(model, ws, qd, qdd, -model.gravity_base());
   rigid_body_columns(model, ws, Y);
+  // Drive columns (detail/drive_terms.hpp): motor k's Ia_k, Fv_k, Fs_k multiply T^T e_k times
+  // (T qdd)_k, (T qd)_k, sign((T qd)_k); with T = I the diagonals qdd_i, qd_i, sign(qd_i).
+  const bool decoupled = model.transmission_is_identity();
+  const MatrixX& T = model.transmission();
   int column = 10 * n;
   if (rotor) {
     Y.middleCols(column, n).setZero();
-    for (int i = 0; i < n; ++i) Y(i, column + i) = qdd[i];
+    for (int k = 0; k < n; ++k) {
+      if (decoupled) {
+        Y(k, column + k) = qdd[k];
+        continue;
+      }
+      const double a = detail::motor_value(model, k, qdd);
+      for (int j = 0; j < n; ++j) Y(j, column + k) = T(k, j) * a;
+    }
     column += n;
   }
   if (friction) {
     Y.middleCols(column, 2 * n).setZero();
-    for (int i = 0; i < n; ++i) {
-      Y(i, column + i) = qd[i];
-      Y(i, column + n + i) = (qd[i] > 0.0) - (qd[i] < 0.0);
+    for (int k = 0; k < n; ++k) {
+      if (decoupled) {
+        Y(k, column + k) = qd[k];
+        Y(k, column + n + k) = detail::sign(qd[k]);
+        continue;
+      }
+      const double w = detail::motor_value(model, k, qd), s = detail::sign(w);
+      for (int j = 0; j < n; ++j) {
+        Y(j, column + k) = T(k, j) * w;
+        Y(j, column + n + k) = T(k, j) * s;
+      }
     }
   }
 }
@@ -221,8 +241,19 @@ void inertia_regressor(const Model& model, Workspace& workspace, const VectorIn&
       }
     }
   }
-  if (rotor)
-    for (int i = 1; i <= n; ++i) Ym((i - 1) * i / 2 + (i - 1), 10 * n + (i - 1)) = 1.0;
+  // Rotor columns: entry (i, j) of T^T diag(Ia) T is sum_k Ia_k T(k, i) T(k, j).
+  if (rotor) {
+    const MatrixX& T = model.transmission();
+    for (int i = 1; i <= n; ++i) {
+      if (model.transmission_is_identity()) {
+        Ym((i - 1) * i / 2 + (i - 1), 10 * n + (i - 1)) = 1.0;
+        continue;
+      }
+      for (int k = 1; k <= i; ++k)
+        for (int m = 0; m < n; ++m)
+          Ym((i - 1) * i / 2 + (k - 1), 10 * n + m) = T(m, i - 1) * T(m, k - 1);
+    }
+  }
 }
 
 }  // namespace dynid

@@ -4,7 +4,7 @@
 #include "dynid/rnea.hpp"
 
 #include "dynid/detail/argument_checks.hpp"
-#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/newton_euler.hpp"
 
@@ -72,9 +72,7 @@ void rnea(const Model& model, Workspace& workspace, const VectorIn& q, const Vec
   DYNID_CHECK_JOINT_VECTOR(tau, model);
   detail::update_joint_transforms(model, ws, q);
   detail::newton_euler(model, ws, qd, qdd, -model.gravity_base(), tau);
-  const VectorX& Ia = model.rotor_inertia();
-  for (int i = 0; i < ws.n; ++i)
-    tau[i] += Ia[i] * qdd[i] + detail::friction_torque(model, i, qd[i]);
+  detail::add_drive_torque(model, qd, qdd, tau);
 }
 
 }  // namespace dynid

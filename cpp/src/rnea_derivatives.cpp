@@ -24,6 +24,7 @@
 #include <string>
 
 #include "dynid/detail/argument_checks.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/spatial.hpp"
 
@@ -111,9 +112,9 @@ void rnea_derivatives(const Model& model, Workspace& workspace, const VectorIn& 
       dtau_dqd(j - 1, k - 1) = S.dot(d.column_qd[k]);
     }
   }
-  // Drive terms: viscous friction Fv qd; Coulomb Fs sign(qd) is flat away from qd = 0 and the
-  // rotor inertia enters dtau/dqdd only.
-  dtau_dqd.diagonal() += model.viscous_friction();
+  // Drive terms: viscous friction T^T diag(Fv) T qd; Coulomb Fs sign(T qd) is flat away from
+  // zero motor velocity and the rotor inertia enters dtau/dqdd only.
+  detail::add_drive_damping(model, dtau_dqd);
 }
 
 }  // namespace dynid

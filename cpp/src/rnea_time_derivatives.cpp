@@ -20,11 +20,12 @@
 // Summed inwards (F_j = sum_{i>=j} f_i) and projected, tau_j = S_j . F_j:
 //   tau'  = S' . F + S . F',   tau'' = S'' . F + 2 S' . F' + S . F''.
 // The drive terms of SPEC section 2 are added last (notes p. 13): Ia qdd + Fv qd + Fs sign(qd)
-// and their derivatives Ia qddd + Fv qdd, Ia qdddd + Fv qddd (Coulomb: flat away from qd = 0).
+// and their derivatives Ia qddd + Fv qdd, Ia qdddd + Fv qddd (Coulomb: flat away from qd = 0);
+// with a transmission T each through T^T (. T ...) (detail/drive_terms.hpp, notes p. 11-13).
 #include "dynid/rnea_time_derivatives.hpp"
 
 #include "dynid/detail/argument_checks.hpp"
-#include "dynid/detail/friction_torque.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/spatial.hpp"
 
@@ -102,6 +103,9 @@ void rnea_time_derivatives(const Model& model, Workspace& workspace, const Vecto
   }
 
   // Inward pass: composite wrenches and their projections on the joint axes.
+  // Decoupled drive terms joint by joint (as before the transmission existed), coupled ones
+  // through T after the pass (detail/drive_terms.hpp).
+  const bool decoupled = model.transmission_is_identity();
   const VectorX& Ia = model.rotor_inertia();
   const VectorX& Fv = model.viscous_friction();
   for (int i = n; i >= 1; --i) {
@@ -113,9 +117,20 @@ void rnea_time_derivatives(const Model& model, Workspace& workspace, const Vecto
     const Vector6 &S = d.S[i], &S1 = d.S_dot[i], &S2 = d.S_ddot[i];
     const Vector6 &F = d.force[i], &F1 = d.force_dot[i], &F2 = d.force_ddot[i];
     const int k = i - 1;
-    tau[k] = S.dot(F) + Ia[k] * qdd[k] + detail::friction_torque(model, k, qd[k]);
-    tau_dot[k] = S1.dot(F) + S.dot(F1) + Ia[k] * qddd[k] + Fv[k] * qdd[k];
-    tau_ddot[k] = S2.dot(F) + 2.0 * S1.dot(F1) + S.dot(F2) + Ia[k] * qdddd[k] + Fv[k] * qddd[k];
+    if (decoupled) {
+      tau[k] = S.dot(F) + Ia[k] * qdd[k] + detail::friction_torque(model, k, qd[k]);
+      tau_dot[k] = S1.dot(F) + S.dot(F1) + Ia[k] * qddd[k] + Fv[k] * qdd[k];
+      tau_ddot[k] = S2.dot(F) + 2.0 * S1.dot(F1) + S.dot(F2) + Ia[k] * qdddd[k] + Fv[k] * qddd[k];
+    } else {
+      tau[k] = S.dot(F);
+      tau_dot[k] = S1.dot(F) + S.dot(F1);
+      tau_ddot[k] = S2.dot(F) + 2.0 * S1.dot(F1) + S.dot(F2);
+    }
+  }
+  if (!decoupled) {
+    detail::add_drive_torque(model, qd, qdd, tau);
+    detail::add_drive_linear(model, qdd, qddd, tau_dot);
+    detail::add_drive_linear(model, qddd, qdddd, tau_ddot);
   }
 }
 

@@ -9,6 +9,7 @@
 
 #include "dynid/detail/argument_checks.hpp"
 #include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/drive_terms.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/newton_euler.hpp"
 
@@ -69,17 +70,13 @@ void Simulator::acceleration(const VectorIn& q, const VectorIn& qd, const Vector
   // c(q, qd) + g(q) of the links (Newton-Euler with qdd = 0), then the drive terms.
   detail::newton_euler(plant_, ws, qd, ws.zeros, -plant_.gravity_base(), ws.bias);
   if (settings_.friction) {
-    const VectorX& Fv = plant_.viscous_friction();
-    const VectorX& Fs = plant_.coulomb_friction();
     const double band = settings_.coulomb_band;
-    for (int i = 0; i < n; ++i) {
-      const double coulomb =
-          band > 0.0 ? std::tanh(qd[i] / band) : static_cast<double>((qd[i] > 0.0) - (qd[i] < 0.0));
-      ws.bias[i] += Fv[i] * qd[i] + Fs[i] * coulomb;
-    }
+    detail::add_drive_friction(plant_, qd, ws.bias, [band](double w) {
+      return band > 0.0 ? std::tanh(w / band) : detail::sign(w);
+    });
   }
   detail::composite_rigid_body(plant_, ws, ws.M);
-  ws.M.diagonal() += plant_.rotor_inertia();
+  detail::add_drive_inertia(plant_, ws.M);
   ws.cholesky.compute(ws.M);
   if (ws.cholesky.info() != Eigen::Success)
     throw std::domain_error(

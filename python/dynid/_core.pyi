@@ -56,7 +56,7 @@ class Model:
         """
         friction(self: dynid._core.Model, qd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
-        Joint friction Fv qd + Fs sign(qd).
+        Joint friction Fv qd + Fs sign(qd); T^T (Fv T qd + Fs sign(T qd)) with a transmission T.
         """
     @staticmethod
     def _gravity_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
@@ -98,7 +98,7 @@ class Model:
         """
         mass_matrix(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
-        Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).
+        Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA); T^T diag(Ia) T with a transmission T.
         """
     @staticmethod
     def _potential_energy_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
@@ -119,7 +119,7 @@ class Model:
         """
         rnea(self: dynid._core.Model, q: object, qd: object, qdd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
-        Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).
+        Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler); with a transmission T the friction is T^T (Fv T qd + Fs sign(T qd)).
         """
     def __init__(
         self,
@@ -179,7 +179,7 @@ class Model:
         self, qd: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
-        Joint friction Fv qd + Fs sign(qd).
+        Joint friction Fv qd + Fs sign(qd); T^T (Fv T qd + Fs sign(T qd)) with a transmission T.
         """
     def gravity(
         self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
@@ -224,7 +224,7 @@ class Model:
         self, q: numpy.typing.ArrayLike, out: numpy.typing.NDArray[numpy.float64] | None = None
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
-        Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA).
+        Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA); T^T diag(Ia) T with a transmission T.
         """
     def potential_energy(
         self, q: numpy.typing.ArrayLike
@@ -253,7 +253,7 @@ class Model:
         out: numpy.typing.NDArray[numpy.float64] | None = None,
     ) -> numpy.typing.NDArray[numpy.float64]:
         """
-        Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler).
+        Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler); with a transmission T the friction is T^T (Fv T qd + Fs sign(T qd)).
         """
     def rnea_derivatives(
         self, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike
@@ -339,6 +339,13 @@ class Model:
         """
     @tool.setter
     def tool(self, arg1: numpy.typing.ArrayLike) -> None: ...
+    @property
+    def transmission(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Transmission coupling T (n, n): motor velocities (after the gears) theta_dot = T qd (notes p. 11-13). Identity (set None) is the decoupled model; otherwise Ia, Fv, Fs are per motor and the drive torque is T^T (Ia T qdd + Fv T qd + Fs sign(T qd)). ValueError naming transmission unless T is finite and invertible (sigma_min / sigma_max > 1e-12).
+        """
+    @transmission.setter
+    def transmission(self, arg1: numpy.typing.ArrayLike | None) -> None: ...
 
 class MomentumObserver:
     """

@@ -94,6 +94,7 @@ def base_parameters(
         robot.dh.tobytes(),
         robot.gravity_vector.tobytes(),
         robot.base.tobytes(),
+        robot.transmission.tobytes(),  # couples the drive columns (docs/transmission.md)
     )
     cache = robot.__dict__.setdefault("_base_parameter_cache", {})
     if key not in cache:

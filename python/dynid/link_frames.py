@@ -93,4 +93,5 @@ def express_in_frames_of(model: Robot, robot: Robot) -> Robot:
         )
     out.params = params
     out.Ia, out.Fv, out.Fs = model.Ia, model.Fv, model.Fs
+    out.transmission = model.transmission
     return out

@@ -57,6 +57,7 @@ class Robot(_core.Model):
         tool: ArrayLike | None = None,
         qlim: ArrayLike | None = None,
         name: str | None = None,
+        transmission: ArrayLike | None = None,
     ) -> Robot:
         """Build a robot from a DH table.
 
@@ -80,6 +81,9 @@ class Robot(_core.Model):
             (n, 2) joint limits; default (-pi, pi) for revolute and (-1, 1) m for prismatic joints.
         name
             A label for printing.
+        transmission
+            (n, n) transmission coupling T, motor velocities theta_dot = T qd (coupled wrists;
+            docs/transmission.md); None means the identity (decoupled drives).
         """
         expected = "dh: expected shape (n, 4) with rows [a, alpha, d, theta], got"
         try:
@@ -100,6 +104,8 @@ class Robot(_core.Model):
             robot.qlim = qlim
         if name:
             robot.name = name
+        if transmission is not None:
+            robot.transmission = transmission
         return robot
 
     @classmethod
@@ -153,7 +159,8 @@ class Robot(_core.Model):
         z, ``qlim`` as limits, Fv and Fs as ``<dynamics damping friction>``, the base and tool
         transforms as fixed placements, and Ia (no URDF field) as a ``dynid: Ia`` comment that
         :meth:`from_urdf` reads back. ValueError naming the first link that is not physically
-        consistent.
+        consistent, or naming ``transmission`` when the drives are coupled (URDF has no place for
+        T; a model file keeps it).
         """
         from .urdf import urdf_text, write_urdf  # on first use: import dynid stays fast
 
@@ -245,6 +252,7 @@ class Robot(_core.Model):
             "Ia": self.Ia,
             "Fv": self.Fv,
             "Fs": self.Fs,
+            "transmission": self.transmission,
         }
 
     def __reduce__(self) -> tuple[object, tuple[dict[str, Any]]]:
@@ -280,6 +288,7 @@ class Robot(_core.Model):
             self.name,
         )
         other.Ia, other.Fv, other.Fs = self.Ia, self.Fv, self.Fs
+        other.transmission = self.transmission
         return other
 
     def with_payload(self, mass: float, com: ArrayLike, inertia: ArrayLike | None = None) -> Robot:
@@ -321,10 +330,11 @@ class Robot(_core.Model):
         return other
 
     def rigid_body(self) -> Robot:
-        """A copy without drive terms (Ia = Fv = Fs = 0): the links alone, e.g. the link
-        equation of an arm with elastic joints (paper eq. (7))."""
+        """A copy without drive terms (Ia = Fv = Fs = 0, transmission identity): the links alone,
+        e.g. the link equation of an arm with elastic joints (paper eq. (7))."""
         other = self.copy()
         other.Ia = other.Fv = other.Fs = np.zeros(self.n)
+        other.transmission = None
         return other
 
     # ---- uses of the model (SPEC section 8) ---------------------------------------------------
@@ -373,6 +383,7 @@ def _robot_from_state(state: dict[str, Any]) -> Robot:
         state["name"],
     )
     robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
+    robot.transmission = state.get("transmission")  # absent in pickles from before it existed
     return robot
 
 

@@ -11,7 +11,8 @@ from .robot import Robot
 
 def model_summary(robot: Robot) -> str:
     """The DH table with joint limits, base/tool transforms when not the identity, the standard
-    parameters per link, the drive terms and the base-parameter counts per regressor kind."""
+    parameters per link, the drive terms (with the transmission T when coupled) and the
+    base-parameter counts per regressor kind."""
     lines = [
         f"{robot.name}: {robot.n} joints ({robot.joint_types}), {robot.convention} DH, "
         f"gravity {np.round(robot.gravity_vector, 6).tolist()}"
@@ -41,6 +42,9 @@ def model_summary(robot: Robot) -> str:
         lines.append(f"  link {i + 1}:" + "".join(f"{v:>11.4g}" for v in row))
     for key in ("Ia", "Fv", "Fs"):
         lines.append(f"  {key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, key)))
+    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+        lines.append("  transmission T (motor velocities T qd; Ia, Fv, Fs per motor):")
+        lines.extend("    " + " ".join(f"{v:>8.4g}" for v in row) for row in robot.transmission)
     counts = [
         (label, base_parameters(robot, "torque", rotor=rotor, friction=friction).count)
         for label, rotor, friction in (

@@ -149,8 +149,15 @@ def _parts(
     qd = real_array(qd, "qd")
     if qd.shape != tau.shape:
         raise ValueError(f"qd: expected the shape of tau {tau.shape}, got {qd.shape}")
-    viscous = robot.Fv * qd
-    coulomb = robot.Fs * np.sign(qd)  # sign(qd / k) = sign(qd) for k > 0, sign(0) = 0
+    # Coupled drives (docs/transmission.md): the same terms on the motor velocities T qd, mapped
+    # back by T^T; they scale the same way.
+    T = robot.transmission
+    coupled = not np.array_equal(T, np.eye(robot.n))
+    w = qd @ T.T if coupled else qd
+    viscous = robot.Fv * w
+    coulomb = robot.Fs * np.sign(w)  # sign(w / k) = sign(w) for k > 0, sign(0) = 0
+    if coupled:
+        viscous, coulomb = viscous @ T, coulomb @ T
     inertial = tau - gravity - viscous - coulomb  # (B + diag(Ia)) qdd + c: scales as 1/k^2
     return gravity + coulomb, viscous, inertial
 

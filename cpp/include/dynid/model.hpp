@@ -62,12 +62,31 @@ class Model {
   std::string link_inconsistency(int i) const;
 
   // Drive terms (n each): rotor inertia reflected to the link side, viscous and Coulomb friction.
+  // With a transmission T (below) they are per MOTOR: motor k spins at theta_dot_k = (T qd)_k
+  // (after its gear) and the drive torque is T^T (Ia . T qdd + Fv . T qd + Fs . sign(T qd)).
   const VectorX& rotor_inertia() const { return Ia_; }
   const VectorX& viscous_friction() const { return Fv_; }
   const VectorX& coulomb_friction() const { return Fs_; }
   void set_rotor_inertia(const VectorIn& Ia);
   void set_viscous_friction(const VectorIn& Fv);
   void set_coulomb_friction(const VectorIn& Fs);
+
+  // Transmission coupling (notes p. 11-13): motor velocities after the gears theta_dot = T qd,
+  // T a constant invertible n x n matrix (coupled wrists). Identity by default: the decoupled
+  // model, evaluated by the same code as before T existed. set_transmission throws
+  // std::invalid_argument naming `transmission` unless T is n x n, finite and well conditioned
+  // (sigma_min / sigma_max > kTransmissionMinRcond); an exact identity restores the decoupled
+  // path. The rotor kinetic energy 1/2 theta_dot^T diag(Ia) theta_dot makes the drive part of
+  // M(q) T^T diag(Ia) T (constant: no Coriolis term) and the motor-side friction reaches the
+  // joints as T^T tau_F (virtual work).
+  static constexpr double kTransmissionMinRcond = 1e-12;
+  const MatrixX& transmission() const { return T_; }
+  bool transmission_is_identity() const { return transmission_identity_; }
+  void set_transmission(const Eigen::Ref<const MatrixX>& T);
+  // T^T diag(Ia) T and T^T diag(Fv) T (kept up to date by the setters; read by
+  // detail/drive_terms.hpp for a coupled transmission).
+  const MatrixX& drive_inertia() const { return drive_inertia_; }
+  const MatrixX& drive_damping() const { return drive_damping_; }
 
   // ---- derived quantities: the algorithms' view (unchecked index; its types are in
   // dynid::detail and may change between releases) ----
@@ -84,6 +103,7 @@ class Model {
  private:
   void update_bodies();
   void update_frames();
+  void update_drive_matrices();
 
   int n_;
   Convention convention_;
@@ -92,6 +112,8 @@ class Model {
   Matrix4 base_, tool_;
   MatrixX parameters_;
   VectorX Ia_, Fv_, Fs_;
+  MatrixX T_, drive_inertia_, drive_damping_;
+  bool transmission_identity_ = true;
 
   std::vector<detail::JointGeometry> joints_;
   std::vector<RigidBodyParameters> bodies_;

@@ -12,8 +12,9 @@ A model file is one object (format in ``docs/cli.md``)::
 names ``a_prev`` and ``alpha_prev`` (a_{i-1}, alpha_{i-1}) may replace ``a`` and ``alpha``, as in
 the LWR4+ tables of ``tests/data/kuka_lwr4_dh.json``. Optional: ``name``, ``joint_types`` (default
 all revolute), ``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4), ``qlim`` (n x 2),
-``params`` (n x 10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each). Unknown fields are
-errors, so that a misspelt ``gravity`` is not silently replaced by the default.
+``params`` (n x 10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each), ``transmission``
+(n x n coupling matrix T, theta_dot = T qd; docs/transmission.md; absent means identity). Unknown
+fields are errors, so that a misspelt ``gravity`` is not silently replaced by the default.
 """
 
 from __future__ import annotations
@@ -56,6 +57,7 @@ FIELDS = (
     "Ia",
     "Fv",
     "Fs",
+    "transmission",
 )
 #: Row fields: the standard name, then the names accepted for it.
 ROW_NAMES = {
@@ -172,6 +174,7 @@ def model_from_dict(data: Any) -> Robot:
             ("Ia", (n,)),
             ("Fv", (n,)),
             ("Fs", (n,)),
+            ("transmission", (n, n)),
         )
         if data.get(key) is not None
     }
@@ -186,7 +189,7 @@ def model_from_dict(data: Any) -> Robot:
         qlim=arrays.get("qlim"),
         name=name,
     )
-    for key in ("Ia", "Fv", "Fs"):
+    for key in ("Ia", "Fv", "Fs", "transmission"):
         if key in arrays:
             setattr(robot, key, arrays[key])
     return robot
@@ -214,6 +217,8 @@ def model_to_dict(robot: Robot) -> dict[str, Any]:
     data["params"] = _floats(robot.params)
     for key in ("Ia", "Fv", "Fs"):
         data[key] = _floats(getattr(robot, key))
+    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+        data["transmission"] = _floats(robot.transmission)
     return data
 
 

@@ -366,12 +366,15 @@ def stable_substeps(
     """Integration steps per control period dt that keep explicit RK4 stable near qd = 0.
 
     There the friction and the controller's damping act as a viscous term D = diag(Fv + Fs /
-    band + Kd), whose fastest mode decays at the largest eigenvalue of M^-1 D; RK4 is stable for
-    rate * h < 2.78, and h is chosen for rate * h <= 2 (at the configuration q).
+    band + Kd) (with coupled drives T^T diag(Fv + Fs / band) T + diag(Kd)), whose fastest mode
+    decays at the largest eigenvalue of M^-1 D; RK4 is stable for rate * h < 2.78, and h is
+    chosen for rate * h <= 2 (at the configuration q).
     """
-    damping = robot.Fv + robot.Fs / coulomb_band + np.asarray(kd, dtype=float)
+    T = robot.transmission
+    motor = T.T @ np.diag(robot.Fv + robot.Fs / coulomb_band) @ T
+    damping = motor + np.diag(np.broadcast_to(np.asarray(kd, dtype=float), (robot.n,)))
     L = np.linalg.cholesky(robot.mass_matrix(q))
-    scaled = np.linalg.solve(L, np.linalg.solve(L, np.diag(damping)).T)  # L^-1 D L^-T
+    scaled = np.linalg.solve(L, np.linalg.solve(L, damping).T)  # L^-1 D L^-T
     rate = float(np.linalg.eigvalsh(0.5 * (scaled + scaled.T))[-1])
     return max(1, int(np.ceil(dt * rate / 2.0)))
 

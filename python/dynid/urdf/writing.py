@@ -45,9 +45,18 @@ Array: TypeAlias = NDArray[np.float64]
 def urdf_text(robot: Any, name: str = "robot") -> str:
     """The URDF of ``robot`` (a :class:`dynid.Robot`) as text. ValueError naming the first link
     that is not physically consistent (URDF consumers need m > 0 and a positive definite inertia
-    that satisfies the triangle inequalities)."""
+    that satisfies the triangle inequalities). ValueError naming ``transmission`` for a robot
+    with coupled drives: URDF's per-joint ``<dynamics>`` cannot hold per-motor friction mapped
+    through T (docs/transmission.md; a model file keeps it)."""
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: expected a non-empty robot name, got {name!r}")
+    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+        raise ValueError(
+            "transmission: a robot with coupled drives (transmission not the identity) cannot be "
+            "written as URDF, whose joint <dynamics> are per joint; save it with "
+            "dynid.save_model (a model file keeps the transmission), or write "
+            "robot.rigid_body()"
+        )
     links = [_physical(robot.params[i], i) for i in range(robot.n)]
     dh = np.asarray(robot.dh, dtype=float)
     standard = robot.convention == "standard"

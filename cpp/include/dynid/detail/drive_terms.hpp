@@ -1,0 +1,124 @@
+// Internal (dynid::detail, not API): the drive terms of SPEC section 2 (rotor inertia, viscous
+// and Coulomb friction) in one place, for every algorithm that adds them (rnea, crba, forward
+// dynamics, energy, friction, the derivatives, the simulator, the regressors).
+//
+// Transmission coupling (notes p. 11-13): the motors turn at theta_dot = T qd (after the gears),
+// so the rotor kinetic energy 1/2 theta_dot^T diag(Ia) theta_dot adds T^T diag(Ia) T to M(q)
+// (constant T: no Coriolis term) and the motor friction tau_F,m = Fv . theta_dot +
+// Fs . sign(theta_dot) reaches the joints by virtual work as T^T tau_F,m. With T = I
+// (Model::transmission_is_identity) every helper runs the per-joint arithmetic of the decoupled
+// model, operation for operation as before T existed, so its results are unchanged to the bit.
+// Nothing here allocates.
+#pragma once
+
+#include "dynid/model.hpp"
+
+namespace dynid::detail {
+
+// sign(0) = 0 (notes, "Adding dynamic terms").
+inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
+
+// Decoupled joint i: Fv_i qd + Fs_i sign(qd).
+inline double friction_torque(const Model& model, int i, double qd) {
+  return model.viscous_friction()[i] * qd + model.coulomb_friction()[i] * sign(qd);
+}
+
+// Motor k's share of a joint-space vector: (T v)_k (theta_dot_k for v = qd).
+template <class V>
+inline double motor_value(const Model& model, int k, const V& v) {
+  const MatrixX& T = model.transmission();
+  double s = 0.0;
+  for (int j = 0; j < model.n(); ++j) s += T(k, j) * v[j];
+  return s;
+}
+
+// tau += T^T e_k f: a torque f of motor k seen at the joints (virtual work).
+template <class Tau>
+inline void add_motor_torque(const Model& model, int k, double f, Tau& tau) {
+  const MatrixX& T = model.transmission();
+  for (int j = 0; j < model.n(); ++j) tau[j] += T(k, j) * f;
+}
+
+// tau += T^T (Fv . w + Fs . coulomb(w)), w = T qd. `coulomb` is sign, or the simulator's
+// smoothing.
+template <class Qd, class Tau, class Coulomb>
+inline void add_drive_friction(const Model& model, const Qd& qd, Tau& tau, Coulomb coulomb) {
+  const VectorX& Fv = model.viscous_friction();
+  const VectorX& Fs = model.coulomb_friction();
+  if (model.transmission_is_identity()) {
+    for (int i = 0; i < model.n(); ++i) tau[i] += Fv[i] * qd[i] + Fs[i] * coulomb(qd[i]);
+    return;
+  }
+  for (int k = 0; k < model.n(); ++k) {
+    const double w = motor_value(model, k, qd);
+    add_motor_torque(model, k, Fv[k] * w + Fs[k] * coulomb(w), tau);
+  }
+}
+
+template <class Qd, class Tau>
+inline void add_drive_friction(const Model& model, const Qd& qd, Tau& tau) {
+  add_drive_friction(model, qd, tau, [](double x) { return sign(x); });
+}
+
+// tau += T^T (Ia . T qdd + Fv . T qd + Fs . sign(T qd)): all drive terms of the torque.
+template <class Qd, class Qdd, class Tau>
+inline void add_drive_torque(const Model& model, const Qd& qd, const Qdd& qdd, Tau& tau) {
+  const VectorX& Ia = model.rotor_inertia();
+  if (model.transmission_is_identity()) {
+    for (int i = 0; i < model.n(); ++i) tau[i] += Ia[i] * qdd[i] + friction_torque(model, i, qd[i]);
+    return;
+  }
+  const VectorX& Fv = model.viscous_friction();
+  const VectorX& Fs = model.coulomb_friction();
+  for (int k = 0; k < model.n(); ++k) {
+    const double a = motor_value(model, k, qdd), w = motor_value(model, k, qd);
+    add_motor_torque(model, k, Ia[k] * a + (Fv[k] * w + Fs[k] * sign(w)), tau);
+  }
+}
+
+// out += T^T (Ia . T acc + Fv . T vel) = drive_inertia acc + drive_damping vel: the drive terms
+// without Coulomb (their time derivatives, Coulomb being flat away from zero velocity).
+template <class Vel, class Acc, class Out>
+inline void add_drive_linear(const Model& model, const Vel& vel, const Acc& acc, Out& out) {
+  const VectorX& Ia = model.rotor_inertia();
+  const VectorX& Fv = model.viscous_friction();
+  if (model.transmission_is_identity()) {
+    for (int i = 0; i < model.n(); ++i) out[i] += Ia[i] * acc[i] + Fv[i] * vel[i];
+    return;
+  }
+  for (int k = 0; k < model.n(); ++k)
+    add_motor_torque(model, k,
+                     Ia[k] * motor_value(model, k, acc) + Fv[k] * motor_value(model, k, vel), out);
+}
+
+// M += T^T diag(Ia) T: the rotors' part of the mass matrix.
+template <class Matrix>
+inline void add_drive_inertia(const Model& model, Matrix& M) {
+  if (model.transmission_is_identity())
+    M.diagonal() += model.rotor_inertia();
+  else
+    M += model.drive_inertia();
+}
+
+// D += T^T diag(Fv) T: d(friction)/d(qd) away from zero motor velocity.
+template <class Matrix>
+inline void add_drive_damping(const Model& model, Matrix& D) {
+  if (model.transmission_is_identity())
+    D.diagonal() += model.viscous_friction();
+  else
+    D += model.drive_damping();
+}
+
+// 1/2 (T qd)^T diag(Ia) (T qd): the rotors' kinetic energy.
+template <class Qd>
+inline double rotor_kinetic_energy(const Model& model, const Qd& qd) {
+  const VectorX& Ia = model.rotor_inertia();
+  double E = 0.0;
+  for (int k = 0; k < model.n(); ++k) {
+    const double w = model.transmission_is_identity() ? qd[k] : motor_value(model, k, qd);
+    E += 0.5 * Ia[k] * w * w;
+  }
+  return E;
+}
+
+}  // namespace dynid::detail
