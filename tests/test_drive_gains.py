@@ -210,6 +210,18 @@ def test_without_a_loaded_run_or_payload_the_scale_is_an_error(lwr, runs):
         identify_drive_gains(lwr, unloaded, loaded, payload=PAYLOAD, payload_mass=MASS)
 
 
+def test_coupled_drives_are_refused(lwr, runs):
+    """tau_j = k_j i_j assumes one motor per joint: a coupled transmission is a ValueError naming
+    the robot, not gains fitted to the wrong model."""
+    unloaded, loaded, _ = runs
+    coupled = lwr.copy()
+    T = np.eye(7)
+    T[5, 4] = 0.2
+    coupled.transmission = T
+    with pytest.raises(ValueError, match=r"^robot: its drives are coupled"):
+        identify_drive_gains(coupled, unloaded, loaded, payload=PAYLOAD)
+
+
 def test_a_loaded_run_without_the_payload_effect_is_rank_deficient(lwr, runs):
     """The 'loaded' run was recorded without the payload: its currents satisfy the homogeneous
     equations, so (theta, k) has a free scale again: RankDeficientError naming the gains."""

@@ -132,6 +132,17 @@ def test_bad_friction_argument_of_identify_log(lwr):
         identify_log(fourier_log(lwr, 1, seconds=1.0), lwr, friction="viscous")
 
 
+def test_asymmetric_friction_is_refused_for_coupled_drives(lwr):
+    """Per-joint direction-dependent friction has no meaning when the motors are coupled
+    (robot.transmission): a ValueError naming friction, which points to the symmetric model."""
+    coupled = lwr.copy()
+    T = np.eye(7)
+    T[6, 5] = -0.15
+    coupled.transmission = T
+    with pytest.raises(ValueError, match=r"^friction: the asymmetric model .* coupled"):
+        identify_log(fourier_log(lwr, 1, seconds=1.0), coupled, friction="asymmetric")
+
+
 # ----------------------------------------------------------------------------- recovery
 
 

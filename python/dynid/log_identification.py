@@ -338,6 +338,12 @@ def identify_log(
         raise ValueError(f"physical: expected True or False, got {physical!r}")
     kind = friction_model(friction)
     symmetric, asymmetric = kind == "symmetric", kind == "asymmetric"
+    if asymmetric and not np.array_equal(robot.transmission, np.eye(robot.n)):
+        raise ValueError(
+            "friction: the asymmetric model acts on each joint's velocity, but the robot's drives "
+            "are coupled (robot.transmission); friction=True gives the motor-side friction "
+            "T^T (Fv T qd + Fs sign(T qd))"
+        )
     if not isinstance(position_torque, (bool, np.bool_)):
         raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
     if not physical and (prior is not None or prior_weight is not None):
