@@ -163,8 +163,8 @@ def test_write_text_atomic(tmp_path) -> None:
 
 
 def test_results_get_the_permissions_of_new_files(tmp_path) -> None:
-    """The staging folder and the atomic file are created private (mkstemp's 0o600); what is
-    left in place has the permissions any new folder or file gets under the umask."""
+    """What is left in place has the permissions any new folder or file gets under the umask
+    (tempfile's would be private), and a rewritten file keeps the permissions it had."""
     import os
     import stat
 
@@ -177,6 +177,9 @@ def test_results_get_the_permissions_of_new_files(tmp_path) -> None:
         os.umask(previous)
     assert stat.S_IMODE((tmp_path / "run").stat().st_mode) == 0o755
     assert stat.S_IMODE((tmp_path / "x.txt").stat().st_mode) == 0o644
+    (tmp_path / "x.txt").chmod(0o600)  # made private by its owner: a rewrite keeps that
+    write_text_atomic(tmp_path / "x.txt", "two")
+    assert stat.S_IMODE((tmp_path / "x.txt").stat().st_mode) == 0o600
 
 
 # --------------------------------------------------------------------------- item 13

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <new>
 
@@ -92,7 +93,13 @@ struct Owner {
 
 py::array_t<double> new_result_array(const std::vector<py::ssize_t>& shape) {
   std::size_t count = 1;
-  for (py::ssize_t d : shape) count *= static_cast<std::size_t>(d);
+  for (py::ssize_t d : shape) {
+    if (d < 0) throw py::value_error("result shape: negative dimension");
+    const auto size = static_cast<std::size_t>(d);
+    if (size != 0 && count > std::numeric_limits<std::size_t>::max() / sizeof(double) / size)
+      throw std::bad_alloc();  // more bytes than the address space: MemoryError
+    count *= size;
+  }
   const std::size_t bytes = count * sizeof(double);
   if (bytes < kMinPooledBytes) return py::array_t<double>(shape);
   auto* owner = new Owner{nullptr, 0, bytes};
@@ -102,11 +109,18 @@ py::array_t<double> new_result_array(const std::vector<py::ssize_t>& shape) {
     delete owner;
     throw;
   }
-  py::capsule base(owner, [](void* p) {
+  auto release = [](void* p) {
     auto* o = static_cast<Owner*>(p);
     pool().give_back(o->data, o->capacity);
     delete o;
-  });
+  };
+  py::capsule base;
+  try {
+    base = py::capsule(owner, release);
+  } catch (...) {
+    release(owner);  // the capsule never took ownership
+    throw;
+  }
   return py::array_t<double>(shape, static_cast<double*>(owner->data), base);
 }
 

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "dynid/detail/argument_checks.hpp"
 #include "dynid/gravity.hpp"
 #include "dynid/rnea.hpp"
 
@@ -12,9 +13,7 @@ namespace {
 using ConstRow = Eigen::Map<const VectorX>;
 
 void check_size(Eigen::Index size, Eigen::Index n, const char* name) {
-  if (size != n)
-    throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(n) +
-                                " values, got " + std::to_string(size));
+  detail::check_size("controller", name, size, n, "one per joint");
 }
 
 void check_reference(const ReferenceTrajectory& r, int n) {

@@ -185,7 +185,7 @@ def identify_drive_gains(
     checks.robot(robot)
     if not isinstance(robot, Robot):
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
-    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+    if robot.coupled:
         raise ValueError(
             "robot: its drives are coupled (robot.transmission); drive gains from currents "
             "assume one motor per joint (tau_j = k_j i_j)"

@@ -338,7 +338,7 @@ def identify_log(
         raise ValueError(f"physical: expected True or False, got {physical!r}")
     kind = friction_model(friction)
     symmetric, asymmetric = kind == "symmetric", kind == "asymmetric"
-    if asymmetric and not np.array_equal(robot.transmission, np.eye(robot.n)):
+    if asymmetric and robot.coupled:
         raise ValueError(
             "friction: the asymmetric model acts on each joint's velocity, but the robot's drives "
             "are coupled (robot.transmission); friction=True gives the motor-side friction "

@@ -1,8 +1,8 @@
 """PNG plots of identification results (matplotlib, Agg backend: no display needed).
 
 Long signals are drawn through :func:`envelope`: a 100k-sample log becomes at most
-``MAX_POINTS`` points per line, keeping each bucket's minimum and maximum, so peaks and spikes stay
-visible while drawing costs the same for a 10 s and a 10 min log. Margins are fixed per figure
+``MAX_POINTS`` + 2 points per line, keeping each bucket's minimum and maximum, so peaks and
+spikes stay visible while drawing costs the same for a 10 s and a 10 min log. Margins are fixed per figure
 (``subplots_adjust``) instead of ``tight_layout``, which draws every figure twice.
 """
 
@@ -27,7 +27,7 @@ DPI = 110
 def envelope(
     t: ArrayLike, y: ArrayLike, max_points: int = MAX_POINTS
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(t, y) reduced to at most ``max_points`` points for drawing: the samples are cut into
+    """(t, y) reduced to at most ``max_points`` + 2 points for drawing: the samples are cut into
     ``max_points // 2`` consecutive buckets and each bucket keeps its minimum and its maximum, in
     time order (the min/max decimation of oscilloscopes), plus the first and the last sample.
     Short signals are returned unchanged."""

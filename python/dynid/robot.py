@@ -274,6 +274,11 @@ class Robot(_core.Model):
     # Unhashable (parameters are settable); mypy objects to None in place of the inherited method.
     __hash__ = None  # type: ignore[assignment]
 
+    @property
+    def coupled(self) -> bool:
+        """True when the drives are coupled: a ``transmission`` other than the identity."""
+        return not np.array_equal(self.transmission, np.eye(self.n))
+
     def copy(self) -> Robot:
         """An independent copy (parameters, drive terms, limits, transforms)."""
         other = Robot.from_dh(

@@ -42,7 +42,7 @@ def model_summary(robot: Robot) -> str:
         lines.append(f"  link {i + 1}:" + "".join(f"{v:>11.4g}" for v in row))
     for key in ("Ia", "Fv", "Fs"):
         lines.append(f"  {key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, key)))
-    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+    if robot.coupled:
         lines.append("  transmission T (motor velocities T qd; Ia, Fv, Fs per motor):")
         lines.extend("    " + " ".join(f"{v:>8.4g}" for v in row) for row in robot.transmission)
     counts = [

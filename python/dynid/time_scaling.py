@@ -152,7 +152,7 @@ def _parts(
     # Coupled drives (docs/transmission.md): the same terms on the motor velocities T qd, mapped
     # back by T^T; they scale the same way.
     T = robot.transmission
-    coupled = not np.array_equal(T, np.eye(robot.n))
+    coupled = robot.coupled
     w = qd @ T.T if coupled else qd
     viscous = robot.Fv * w
     coulomb = robot.Fs * np.sign(w)  # sign(w / k) = sign(w) for k > 0, sign(0) = 0

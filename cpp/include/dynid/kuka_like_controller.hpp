@@ -36,7 +36,8 @@ class KukaLikeController : public ElasticController {
  public:
   // `model` (the controller's links) and `reference` are kept by reference and must outlive the
   // controller; `tau_user` is null or (reference.samples x n) row-major, kept likewise.
-  // std::invalid_argument naming model, stiffness, a gain or reference on a size or sign error.
+  // std::invalid_argument naming stiffness, a gain or reference on a size or sign error (the
+  // binding checks that the model has the plant's joints).
   KukaLikeController(const Model& model, const VectorIn& stiffness, const KukaLikeGains& gains,
                      GravityCompensation gravity, const ReferenceTrajectory& reference,
                      const double* tau_user = nullptr);

@@ -217,7 +217,7 @@ def model_to_dict(robot: Robot) -> dict[str, Any]:
     data["params"] = _floats(robot.params)
     for key in ("Ia", "Fv", "Fs"):
         data[key] = _floats(getattr(robot, key))
-    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+    if robot.coupled:
         data["transmission"] = _floats(robot.transmission)
     return data
 

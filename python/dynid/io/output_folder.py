@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 import secrets
 import shutil
-import tempfile
+import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -65,7 +65,7 @@ def output_folder(
 
 def _new_folder(parent: Path, prefix: str, suffix: str) -> Path:
     """A new, uniquely named folder in ``parent`` with the permissions of any new folder
-    (0o777 less the umask: tempfile.mkdtemp's 0o700 would make the results private)."""
+    (0o777 less the umask, applied by the kernel: tempfile.mkdtemp's would be 0o700)."""
     while True:
         path = parent / f"{prefix}{secrets.token_hex(4)}{suffix}"
         try:
@@ -75,26 +75,32 @@ def _new_folder(parent: Path, prefix: str, suffix: str) -> Path:
         return path
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)  # the only way to read it is to set it: put it straight back
-    os.umask(mask)
-    return mask
+def _new_file(parent: Path, prefix: str) -> tuple[int, Path]:
+    """A new, uniquely named file in ``parent``, open for writing, with the permissions of any new
+    file (0o666 less the umask, applied by the kernel: tempfile.mkstemp's would be 0o600)."""
+    while True:
+        path = parent / f"{prefix}{secrets.token_hex(4)}.partial"
+        try:
+            return os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666), path
+        except FileExistsError:
+            continue
 
 
 def write_text_atomic(path: PathLike, text: str) -> Path:
     """Write ``text`` to ``path`` through a temporary file in the same folder and a rename, so
-    that ``path`` is either the old file or the complete new one, never a truncated mix."""
+    that ``path`` is either the old file or the complete new one, never a truncated mix. A file
+    that is replaced keeps its permissions; a new one gets those of any new file."""
     target = Path(path)
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent or ".")
+    handle, temporary = _new_file(target.parent, f".{target.name}.")
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:
             stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())
-        # mkstemp makes the file private (0o600); the result gets a new file's permissions.
-        os.chmod(temporary, 0o666 & ~_umask())
+        if target.exists():
+            os.chmod(temporary, stat.S_IMODE(target.stat().st_mode))
         os.replace(temporary, target)
     except BaseException:
-        Path(temporary).unlink(missing_ok=True)
+        temporary.unlink(missing_ok=True)
         raise
     return target

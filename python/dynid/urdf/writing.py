@@ -50,7 +50,7 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
     through T (docs/transmission.md; a model file keeps it)."""
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: expected a non-empty robot name, got {name!r}")
-    if not np.array_equal(robot.transmission, np.eye(robot.n)):
+    if robot.coupled:
         raise ValueError(
             "transmission: a robot with coupled drives (transmission not the identity) cannot be "
             "written as URDF, whose joint <dynamics> are per joint; save it with "
