@@ -2,8 +2,8 @@
 
 Long signals are drawn through :func:`envelope`: a 100k-sample log becomes at most
 ``MAX_POINTS`` + 2 points per line, keeping each bucket's minimum and maximum, so peaks and
-spikes stay visible while drawing costs the same for a 10 s and a 10 min log. Margins are fixed per figure
-(``subplots_adjust``) instead of ``tight_layout``, which draws every figure twice.
+spikes stay visible while drawing costs the same for a 10 s and a 10 min log. Margins are fixed
+per figure (``subplots_adjust``) instead of ``tight_layout``, which draws every figure twice.
 """
 
 from __future__ import annotations
