@@ -26,12 +26,10 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.io import load_log
 from dynid.log_identification import identify_log, validate_log
+from real_logs import lwr4_logs
 
-DATA = Path(__file__).parent / "data"
 PRIOR = Path(__file__).parent.parent / "examples" / "kuka_lwr4_urdf_prior.json"
-SKIP = 500
 COMMON = {"rotor": True, "method": "wls"}
 N = 7
 
@@ -50,10 +48,7 @@ WRIST = slice(4, 7)
 
 @pytest.fixture(scope="module")
 def logs():
-    return (
-        load_log(DATA / "measurements_1.npz", skip=SKIP),
-        load_log(DATA / "measurements_2.npz", skip=SKIP),
-    )
+    return lwr4_logs()
 
 
 @pytest.fixture(scope="module")

@@ -22,12 +22,10 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.io import load_log
 from dynid.log_identification import DEFAULT_PRIOR_WEIGHT, identify_log, validate_log
+from real_logs import DATA, lwr4_logs
 
-DATA = Path(__file__).parent / "data"
 PRIOR = Path(__file__).parent.parent / "examples" / "kuka_lwr4_urdf_prior.json"
-SKIP = 500
 OPTIONS = {"rotor": True, "friction": True, "offset": True, "method": "wls"}
 
 #: Validation relative RMS per joint of the unconstrained fit (tests/test_real_data.py) and of
@@ -53,10 +51,7 @@ RATIO_BOUND_POSITION = np.array([1.25, 1.25, 1.25, 1.25, 1.25, 1.25, 2.05])
 
 @pytest.fixture(scope="module")
 def logs():
-    return (
-        load_log(DATA / "measurements_1.npz", skip=SKIP),
-        load_log(DATA / "measurements_2.npz", skip=SKIP),
-    )
+    return lwr4_logs()
 
 
 @pytest.fixture(scope="module")

@@ -31,6 +31,7 @@ import pytest
 
 import dynid
 from conftest import ARM_CASES, make_arm, random_state
+from coupled_robots import coupled_puma
 from cpp_programs import build_and_run
 from dynid import _core
 
@@ -39,7 +40,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
 from pinocchio_arm import build_model
 
 # PUMA-like coupled wrist: motor 5 turns with joint 4, motor 6 with joints 4 and 5.
-T_WRIST = np.array([[1.0, 0.0, 0.0], [0.2, 1.0, 0.0], [-0.15, 0.3, 1.0]])
 
 
 def scale(expected: np.ndarray) -> float:
@@ -49,14 +49,6 @@ def scale(expected: np.ndarray) -> float:
 def assert_close(actual, expected, rtol: float) -> None:
     expected = np.asarray(expected)
     np.testing.assert_allclose(actual, expected, rtol=0, atol=rtol * scale(expected))
-
-
-def coupled_puma() -> dynid.Robot:
-    robot = dynid.models.puma560()
-    T = np.eye(6)
-    T[3:, 3:] = T_WRIST
-    robot.transmission = T
-    return robot
 
 
 def puma_state(rng: np.random.Generator, count: int | None = None):

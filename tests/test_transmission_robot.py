@@ -10,17 +10,8 @@ import numpy as np
 import pytest
 
 import dynid
+from coupled_robots import T_WRIST, coupled_puma
 from dynid.io.model_files import load_model, model_to_dict, save_model
-
-T_WRIST = np.array([[1.0, 0.0, 0.0], [0.2, 1.0, 0.0], [-0.15, 0.3, 1.0]])
-
-
-def coupled_puma() -> dynid.Robot:
-    robot = dynid.models.puma560()
-    T = np.eye(6)
-    T[3:, 3:] = T_WRIST
-    robot.transmission = T
-    return robot
 
 
 def test_default_is_the_identity_and_read_only() -> None:

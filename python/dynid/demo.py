@@ -110,11 +110,6 @@ def run_demo(
 
     # 1. Data from the virtual controller.
     truth = controller_model()
-    noise = {
-        "model_noise": model_noise,
-        "torque_noise": torque_noise,
-        "position_noise": position_noise,
-    }
     controller = VirtualController(
         truth,
         seed=seed,
@@ -238,7 +233,9 @@ def run_demo(
                 "validation": validation,
                 "seed": seed,
                 "link_friction": link_friction,
-                **noise,
+                "model_noise": model_noise,
+                "torque_noise": torque_noise,
+                "position_noise": position_noise,
             },
             "tracking_error_max": [float(e) for e in tracking],
             "coefficients": ident.coefficients(),
