@@ -18,6 +18,7 @@
 #include "dynid/dynid.hpp"
 
 #include "allocation_counter.hpp"  // cpp/examples/
+#include "test_support.hpp"
 
 namespace {
 
@@ -47,20 +48,6 @@ dynid::Model make_arm() {
   return model;
 }
 
-// Runs call() and checks it throws std::invalid_argument starting with "name:".
-template <class Call>
-bool names_argument(const char* name, Call call) {
-  try {
-    call();
-  } catch (const std::invalid_argument& e) {
-    if (std::string(e.what()).rfind(std::string(name) + ":", 0) == 0) return true;
-    std::printf("expected an error naming %s, got: %s\n", name, e.what());
-    return false;
-  }
-  std::printf("expected std::invalid_argument naming %s, nothing thrown\n", name);
-  return false;
-}
-
 }  // namespace
 
 int main() {
@@ -70,19 +57,7 @@ int main() {
   dynid::VectorX q(n), qd(n), qdd(n), qddd(n), qdddd(n), tau(n), tau_dot(n), tau_ddot(n),
       rnea_tau(n);
 
-  counting = true;
-  {
-    dynid::VectorX probe(n);
-    std::vector<double> probe_new(n);
-    probe.setZero();
-    probe_new[0] = probe[0];
-  }
-  counting = false;
-  if (allocations < 2) {
-    std::printf("allocation counter broken: %ld of 2 probe allocations seen\n", allocations);
-    return 3;
-  }
-  allocations = 0;
+  if (!allocation_counter_works(n)) return 3;
 
   double sink = 0.0, max_difference_to_rnea = 0.0;
   counting = true;

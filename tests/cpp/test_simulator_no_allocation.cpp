@@ -19,6 +19,7 @@
 #include "dynid/dynid.hpp"
 
 #include "allocation_counter.hpp"  // cpp/examples/
+#include "test_support.hpp"
 
 namespace {
 
@@ -72,19 +73,7 @@ struct Buffers {
 }  // namespace
 
 int main() {
-  counting = true;
-  {
-    VectorX probe(kJoints);
-    std::vector<double> probe_new(kJoints);
-    probe.setZero();
-    probe_new[0] = probe[0];
-  }
-  counting = false;
-  if (allocations < 2) {
-    std::printf("allocation counter broken: %ld of 2 probe allocations seen\n", allocations);
-    return 3;
-  }
-  allocations = 0;
+  if (!allocation_counter_works(kJoints)) return 3;
 
   const Model plant = lwr_like();
   const int rows = kPeriods + 1;
