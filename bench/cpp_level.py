@@ -1,4 +1,5 @@
-"""The C++ level of the benchmark: write the arm, configure and build bench/CMakeLists.txt, run.
+"""The C++ level of the benchmark: write the arm, configure the root project with the benchmark
+(bench/CMakeLists.txt, DYNID_BUILD_BENCH) and build it, run.
 
 The C++ program (cpp/bench_dynamics.cpp) does its own agreement check and timing and prints one
 JSON line; this module only prepares its input, builds it with CMake and reads its answer.
@@ -74,7 +75,9 @@ def build(build_dir: Path, *, native: bool, with_pinocchio: bool) -> Path:
     options = {
         "CMAKE_BUILD_TYPE": "Release",
         "CMAKE_PREFIX_PATH": ";".join(str(p) for p in prefixes),
-        "BENCH_NATIVE": "ON" if native else "OFF",
+        "DYNID_BUILD_BENCH": "ON",
+        "DYNID_BUILD_TESTS": "OFF",
+        "DYNID_NATIVE": "ON" if native else "OFF",
         "BENCH_WITH_PINOCCHIO": "ON" if with_pinocchio else "OFF",
     }
     build_dir.mkdir(parents=True, exist_ok=True)
@@ -84,7 +87,7 @@ def build(build_dir: Path, *, native: bool, with_pinocchio: bool) -> Path:
     cache = build_dir / "CMakeCache.txt"
     if cache.exists() and (not stamp.exists() or json.loads(stamp.read_text()) != options):
         cache.unlink()
-    command = [cmake, "-S", str(BENCH_DIR), "-B", str(build_dir)]
+    command = [cmake, "-S", str(BENCH_DIR.parent), "-B", str(build_dir)]
     if not cache.exists() and shutil.which("ninja"):
         command += ["-G", "Ninja"]
     command += [f"-D{key}={value}" for key, value in options.items()]
@@ -103,9 +106,10 @@ def build(build_dir: Path, *, native: bool, with_pinocchio: bool) -> Path:
             "bench: compiling Pinocchio's headers (first build only: several minutes)", flush=True
         )
     command = [cmake, "--build", str(build_dir), "--parallel", str(os.cpu_count() or 1)]
+    command += ["--target", EXECUTABLE]
     hint = "bench: --skip-cpp times the Python level alone"
     _run_logged(command, build_dir / "build.log", "C++ build", hint)
-    return build_dir / EXECUTABLE
+    return build_dir / "bench" / EXECUTABLE
 
 
 def pinning_command(cpu: int | None) -> list[str]:

@@ -15,9 +15,7 @@ import argparse
 import datetime
 import json
 import os
-import platform
 import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +23,7 @@ import cpp_level  # sibling modules: bench/ is sys.path[0] when run as a script
 import numpy as np
 import pinocchio_arm
 import python_level
+from machine import describe_machine
 
 import dynid
 
@@ -133,20 +132,7 @@ def import_pinocchio(disabled: bool) -> Any | None:
 
 
 def machine(cpu_pinned: int | None) -> dict[str, Any]:
-    model = ""
-    if Path("/proc/cpuinfo").exists():
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    return {
-        "cpu": model or platform.processor(),
-        "cpu_count": os.cpu_count(),
-        "platform": platform.platform(),
-        "python": sys.version.split()[0],
-        "numpy": np.__version__,
-        "cpp_pinned_cpu": cpu_pinned,
-    }
+    return {**describe_machine(), "numpy": np.__version__, "cpp_pinned_cpu": cpu_pinned}
 
 
 def git_state() -> dict[str, Any]:

@@ -16,6 +16,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
+from cpp_programs import CppTests, shared_build
 from reference_model import Arm, params_to_physical
 
 SEED = 20240611
@@ -172,3 +173,15 @@ def rng() -> np.random.Generator:
 def arm(request: pytest.FixtureRequest) -> Arm:
     """A reference arm (known table and links) of each kind."""
     return make_arm(request.param)
+
+
+# ------------------------------------------------------------------ the C++ test programs
+
+
+@pytest.fixture(scope="session")
+def cpp_tests(tmp_path_factory: pytest.TempPathFactory) -> CppTests:
+    """tests/cpp built once per run against the installed package (tests/cpp_programs.py)."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the folder the workers of this run share
+    return shared_build(root / "cpp-tests")

@@ -1,21 +1,41 @@
-"""Building and running the small C++ test programs of tests/cpp/ (the zero-allocation proofs)
-straight from the core's sources: one compiler search, one Eigen search, one build-and-run.
+"""The C++ test programs of tests/cpp/ (the size-check probe, the zero-allocation proofs and the
+real-time example), built ONCE per test session, the way a C++ user builds against dynid: the
+standalone CMake project tests/cpp configured with ``find_package(dynid)`` against the INSTALLED
+package, so every program links the very ``dynid::core`` the wheel ships (its SIMD lane
+kernels, run-time dispatch and Eigen settings), compiled with AddressSanitizer and
+UndefinedBehaviorSanitizer when the compiler supports them.
 
-Without a C++ compiler the calling test is skipped, except in CI, where it fails: the proofs must
-run on a clean machine (the `test` extra brings Eigen; the compiler comes with the machine)."""
+The session fixture ``cpp_tests`` (conftest.py) builds it once for the whole run: under
+pytest-xdist the first worker that needs it builds it in a folder shared by the workers, under a
+file lock, and the others wait for it and reuse it.
+Without a C++ compiler or cmake the calling test is skipped, except in CI, where it fails: the
+proofs must run on a clean machine (requirements/test.txt brings Eigen, CMake and Ninja; the
+compiler comes with the machine)."""
 
 from __future__ import annotations
 
+import json
 import os
+import re
 import shutil
 import subprocess
 import sys
-from collections.abc import Sequence
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import pytest
+from filelock import FileLock
 
 REPO = Path(__file__).resolve().parents[1]
+PROGRAMS = (
+    "size_checks",
+    "rls_no_allocation",
+    "simulator_no_allocation",
+    "elastic_no_allocation",
+    "transmission_no_allocation",
+    "uses_no_allocation",
+    "realtime_loop",
+)
 
 
 def find_compiler() -> str | None:
@@ -25,58 +45,112 @@ def find_compiler() -> str | None:
     return None
 
 
-def find_eigen() -> Path:
-    """Eigen's include folder: the cmeel-eigen wheel (as in CMakeLists.txt), else the system."""
-    for entry in map(Path, sys.path):
-        candidate = entry / "cmeel.prefix" / "include" / "eigen3"
-        if (candidate / "Eigen" / "Core").is_file():
-            return candidate
-    for candidate in (Path("/usr/include/eigen3"), Path("/usr/local/include/eigen3")):
-        if (candidate / "Eigen" / "Core").is_file():
-            return candidate
-    pytest.fail("Eigen not found: pip install cmeel-eigen (or install the system's eigen3)")
+def find_tool(name: str) -> str | None:
+    """A build tool on PATH, else next to this Python (a venv's bin/), else its PyPI package's."""
+    found = shutil.which(name) or shutil.which(name, path=str(Path(sys.executable).parent))
+    if found:
+        return found
+    try:  # the `cmake` and `ninja` wheels keep their binaries in the package
+        module = __import__(name)
+        folder = getattr(module, "CMAKE_BIN_DIR", None) or getattr(module, "BIN_DIR", None)
+    except ImportError:
+        return None
+    return shutil.which(name, path=folder) if folder else None
 
 
-def build_and_run(
-    folder: Path,
-    program: str,
-    core_sources: Sequence[str] | None = None,
-    optimisation: str = "-O2",
-) -> str:
-    """Compile ``tests/cpp/{program}.cpp`` with the named ``cpp/src`` files (default: all of
-    them), ``-DNDEBUG``, into ``folder``, run it and return its output; the build and the run
-    must succeed."""
-    compiler = find_compiler()
-    if compiler is None:
-        assert not os.environ.get("CI"), "CI needs a C++ compiler (CXX, g++, c++, clang++)"
-        pytest.skip("no C++ compiler found (CXX, g++, c++, clang++)")
-    if core_sources is None:
-        sources = sorted(str(p) for p in (REPO / "cpp" / "src").glob("*.cpp"))
-    else:
-        sources = [str(REPO / "cpp" / "src" / f"{name}.cpp") for name in core_sources]
-    executable = folder / program
-    build = subprocess.run(
-        [
-            compiler,
-            optimisation,
-            "-DNDEBUG",
-            "-std=c++17",
-            f"-I{REPO / 'cpp' / 'include'}",
-            f"-I{REPO / 'cpp' / 'examples'}",  # allocation_counter.hpp
-            f"-I{find_eigen()}",
-            str(REPO / "tests" / "cpp" / f"{program}.cpp"),
-            *sources,
-            "-o",
-            str(executable),
-        ],
-        check=False,
+def require_build_tools() -> tuple[str, str, str]:
+    """(compiler, cmake, ctest), or skip (fail in CI) when one is missing."""
+    compiler, cmake, ctest = find_compiler(), find_tool("cmake"), find_tool("ctest")
+    if compiler is None or cmake is None or ctest is None:
+        assert not os.environ.get("CI"), (
+            f"CI needs a C++ compiler and cmake/ctest: compiler={compiler}, cmake={cmake}, "
+            f"ctest={ctest}"
+        )
+        pytest.skip(
+            "needs a C++ compiler (CXX, g++, c++, clang++) and cmake/ctest (PATH or "
+            f"`pip install cmake`): compiler={compiler}, cmake={cmake}, ctest={ctest}"
+        )
+    return compiler, cmake, ctest
+
+
+@dataclass(frozen=True)
+class CppTests:
+    """The built tests/cpp project: its folder, whether the sanitizers are on, the configure
+    output and the tools that built it."""
+
+    build: Path
+    sanitized: bool
+    configure_output: str
+    ctest: str
+
+    def run(self, program: str, *arguments: str) -> str:
+        """Run one program of the build; it must exit 0 without a sanitizer report. Returns its
+        standard output and error."""
+        assert program in PROGRAMS, program
+        done = subprocess.run(
+            [str(self.build / program), *arguments],
+            capture_output=True,
+            text=True,
+            timeout=600,
+            check=False,
+            env={**os.environ, **SANITIZER_OPTIONS},
+        )
+        output = done.stdout + done.stderr
+        assert done.returncode == 0, output
+        assert not SANITIZER_REPORT.search(output), output
+        return output
+
+
+# The same settings as ctest's (tests/cpp/CMakeLists.txt): stop at the first report.
+SANITIZER_OPTIONS = {
+    "ASAN_OPTIONS": "halt_on_error=1:detect_leaks=1:strict_string_checks=1",
+    "UBSAN_OPTIONS": "print_stacktrace=1:halt_on_error=1",
+}
+SANITIZER_REPORT = re.compile(
+    r"AddressSanitizer|LeakSanitizer|UndefinedBehaviorSanitizer|runtime error:"
+)
+
+
+def build_cpp_tests(folder: Path) -> CppTests:
+    """Configure tests/cpp against the installed dynid in ``folder`` and build every program."""
+    import dynid.cmake
+
+    compiler, cmake, ctest = require_build_tools()
+    configure = [
+        cmake,
+        "-S",
+        str(REPO / "tests" / "cpp"),
+        "-B",
+        str(folder),
+        f"-Ddynid_DIR={dynid.cmake.get_cmake_dir()}",
+        f"-DCMAKE_CXX_COMPILER={compiler}",
+        "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON",
+    ]
+    ninja = find_tool("ninja")
+    if ninja:
+        configure += ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"]
+    step = subprocess.run(configure, capture_output=True, text=True, timeout=300, check=False)
+    assert step.returncode == 0, step.stdout + step.stderr
+    configured = step.stdout
+    step = subprocess.run(
+        [cmake, "--build", str(folder), "--parallel", str(os.cpu_count() or 1)],
         capture_output=True,
         text=True,
         timeout=900,
+        check=False,
     )
-    assert build.returncode == 0, build.stderr
-    run = subprocess.run(
-        [str(executable)], check=False, capture_output=True, text=True, timeout=300
-    )
-    assert run.returncode == 0, run.stdout + run.stderr
-    return run.stdout
+    assert step.returncode == 0, step.stdout + step.stderr
+    return CppTests(folder, "sanitizers ON" in configured, configured, ctest)
+
+
+def shared_build(folder: Path) -> CppTests:
+    """The build in ``folder``, made by the first process that asks (a file lock keeps the
+    pytest-xdist workers of one run from building it twice) and reused by the others."""
+    record = folder / "cpp_tests.json"
+    with FileLock(f"{folder}.lock"):
+        if record.is_file():
+            fields = json.loads(record.read_text())
+            return CppTests(**{**fields, "build": Path(fields["build"])})
+        built = build_cpp_tests(folder)
+        record.write_text(json.dumps({**asdict(built), "build": str(built.build)}))
+        return built

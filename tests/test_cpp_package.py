@@ -20,31 +20,15 @@ import importlib.metadata
 import json
 import os
 import re
-import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 import dynid.cmake
-from cpp_programs import find_compiler
+from cpp_programs import REPO, find_compiler, find_tool
 
-REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "cpp" / "examples"
-
-
-def find_tool(name: str) -> str | None:
-    """A build tool on PATH, else next to this Python (a venv's bin/), else its PyPI package's."""
-    found = shutil.which(name) or shutil.which(name, path=str(Path(sys.executable).parent))
-    if found:
-        return found
-    try:  # the `cmake` and `ninja` wheels keep their binaries in the package
-        module = __import__(name)
-        folder = getattr(module, "CMAKE_BIN_DIR", None) or getattr(module, "BIN_DIR", None)
-    except ImportError:
-        return None
-    return shutil.which(name, path=folder) if folder else None
 
 
 def test_installed_package_has_headers_library_and_cmake_config():

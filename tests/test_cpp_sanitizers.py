@@ -1,11 +1,12 @@
-"""The C++ tests (tests/cpp: the size-check probe and the zero-allocation proofs) built with
-AddressSanitizer and UndefinedBehaviorSanitizer against the INSTALLED package, run by ctest.
+"""The C++ tests (tests/cpp: the size-check probe, the zero-allocation proofs and the real-time
+example) built with AddressSanitizer and UndefinedBehaviorSanitizer against the INSTALLED
+package (tests/cpp_programs.py, built once per session), run by ctest.
 
 - size_checks: every public algorithm, given each argument with a wrong size in turn, throws
-  std::invalid_argument naming that argument (SPEC §9), and with the right sizes agrees with
+  std::invalid_argument naming that argument, and with the right sizes agrees with
   independent routes (rnea = M qdd + S qd + g + friction, Y pi = rnea, ...) to 1e-9;
-- rls_no_allocation, simulator_no_allocation and cpp/examples/realtime_loop: 0 heap allocations
-  in their loops (counted through the sanitizer's allocation hook under ASan);
+- the *_no_allocation programs and cpp/examples/realtime_loop: 0 heap allocations in their loops
+  (counted through the sanitizer's allocation hook under ASan);
 - any sanitizer report fails (ctest's FAIL_REGULAR_EXPRESSION, and checked here again). The
   program is instrumented while the installed core is not: this only works because the exported
   dynid::core carries Eigen's alignment settings (EIGEN_MALLOC_ALREADY_ALIGNED, ...), without
@@ -21,77 +22,40 @@ import os
 import re
 import subprocess
 
-import pytest
-
 import dynid.cmake
-from test_cpp_package import REPO, find_compiler, find_tool
-
-SANITIZER_REPORT = re.compile(
-    r"AddressSanitizer|LeakSanitizer|UndefinedBehaviorSanitizer|runtime error:"
-)
+from cpp_programs import PROGRAMS, REPO, SANITIZER_REPORT, CppTests, find_compiler
 
 
-def test_cpp_tests_pass_under_address_and_undefined_sanitizers(tmp_path, record_property):
-    compiler = find_compiler()
-    cmake = find_tool("cmake")
-    ctest = find_tool("ctest")
-    if compiler is None or cmake is None or ctest is None:
-        assert not os.environ.get("CI"), f"CI needs a C++ compiler and cmake: {compiler}, {cmake}"
-        pytest.skip(
-            "needs a C++ compiler and cmake/ctest: "
-            f"compiler={compiler}, cmake={cmake}, ctest={ctest}"
-        )
-    build = tmp_path / "build"
-    configure = [
-        cmake,
-        "-S",
-        str(REPO / "tests" / "cpp"),
-        "-B",
-        str(build),
-        f"-Ddynid_DIR={dynid.cmake.get_cmake_dir()}",
-        f"-DCMAKE_CXX_COMPILER={compiler}",
-        "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON",
-    ]
-    ninja = find_tool("ninja")
-    if ninja:
-        configure += ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"]
-    step = subprocess.run(configure, capture_output=True, text=True, timeout=300, check=False)
-    assert step.returncode == 0, step.stdout + step.stderr
-    sanitized = "sanitizers ON" in step.stdout
-    record_property("sanitizers", sanitized)
+def test_cpp_tests_pass_under_address_and_undefined_sanitizers(
+    cpp_tests: CppTests, record_property
+):
+    record_property("sanitizers", cpp_tests.sanitized)
+    compiler = find_compiler() or ""
     if os.environ.get("CI") and compiler.endswith(("g++", "clang++")):
-        assert sanitized, step.stdout  # GCC and Clang on Linux/macOS support both
-
-    step = subprocess.run(
-        [cmake, "--build", str(build), "--parallel", "2"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert step.returncode == 0, step.stdout + step.stderr
+        assert cpp_tests.sanitized, cpp_tests.configure_output  # GCC and Clang support both
 
     # The programs were compiled against the installed headers with the sanitizers and with the
     # Eigen settings of the installed core, which come from the exported target.
-    for entry in json.loads((build / "compile_commands.json").read_text()):
+    for entry in json.loads((cpp_tests.build / "compile_commands.json").read_text()):
         command = entry.get("command") or " ".join(entry["arguments"])
         assert dynid.cmake.get_include() in command, command
+        assert str(REPO / "cpp" / "include") not in command, command
         assert "-DEIGEN_MALLOC_ALREADY_ALIGNED=" in command, command
         assert "-DEIGEN_MAX_ALIGN_BYTES=" in command, command
-        if sanitized:
+        if cpp_tests.sanitized:
             assert "-fsanitize=address,undefined" in command, command
 
     run = subprocess.run(
-        [ctest, "--test-dir", str(build), "--output-on-failure", "-V"],
+        [cpp_tests.ctest, "--test-dir", str(cpp_tests.build), "--output-on-failure", "-V"],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=900,
         check=False,
     )
     output = run.stdout + run.stderr
     assert run.returncode == 0, output
     assert not SANITIZER_REPORT.search(output), output
-    assert "100% tests passed out of 4" in output, output
+    assert f"100% tests passed out of {len(PROGRAMS)}" in output, output
     assert re.search(r"size checks: (\d+) probes, 0 failures", output), output
     assert "allocations_during_updates=0" in output, output
     assert re.search(r"allocations: 0 allocations in 1000 cycles", output), output

@@ -35,7 +35,6 @@ import pytest
 
 import dynid
 from conftest import ARM_CASES, make_arm
-from cpp_programs import build_and_run
 from test_rnea_time_derivatives import D1, D2, relative_error, sine_motion
 
 REPO = Path(__file__).resolve().parents[1]
@@ -296,11 +295,11 @@ def test_the_documented_example_runs() -> None:
 # ------------------------------------------------------------------------- real time
 
 
-def test_no_heap_allocation_per_call(tmp_path):
-    """Compiles tests/cpp/test_elastic_no_allocation.cpp with the core's sources and runs it: it
+def test_no_heap_allocation_per_call(cpp_tests):
+    """Runs tests/cpp/test_elastic_no_allocation.cpp (built against the installed package): it
     counts every operator new and malloc during 10^4 rnea_time_derivatives calls and during
     elastic simulator runs under MotorPD and the KUKA-like controller, checks tau against rnea,
     and that size errors name the argument."""
-    output = build_and_run(tmp_path, "test_elastic_no_allocation", optimisation="-O1")
+    output = cpp_tests.run("elastic_no_allocation")
     assert re.search(r"^allocations_during_calls=0$", output, re.MULTILINE), output
     print(output)

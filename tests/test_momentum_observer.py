@@ -27,7 +27,6 @@ import pytest
 
 import dynid
 from conftest import make_arm
-from cpp_programs import build_and_run
 
 REPO = Path(__file__).resolve().parents[1]
 DT = 1e-3
@@ -250,11 +249,11 @@ def test_residual_files_and_plot(tmp_path, contact_run):
 # ----------------------------------------------------------------------------- real time
 
 
-def test_no_heap_allocation_per_update(tmp_path):
-    """Compiles tests/cpp/test_uses_no_allocation.cpp with the core's sources and runs it: it
+def test_no_heap_allocation_per_update(cpp_tests):
+    """Runs tests/cpp/test_uses_no_allocation.cpp (built against the installed package): it
     counts every operator new and malloc during 10^4 observer updates, rnea_derivatives and
     jacobian_dot calls, and checks their size errors name the argument."""
-    output = build_and_run(tmp_path, "test_uses_no_allocation", optimisation="-O1")
+    output = cpp_tests.run("uses_no_allocation")
     assert re.search(r"^allocations_during_calls=0$", output, re.MULTILINE), output
     print(output)
 

@@ -30,7 +30,6 @@ from hypothesis import given, settings
 from numpy.typing import NDArray
 
 import dynid
-from cpp_programs import build_and_run
 
 RLS = dynid.RecursiveLeastSquares
 REPO = Path(__file__).resolve().parents[1]
@@ -467,13 +466,11 @@ def test_accepted_input_forms():
 # --------------------------------------------------------------------------- real time
 
 
-def test_update_makes_no_heap_allocation(tmp_path, record_property):
-    """Compiles tests/cpp/test_rls_no_allocation.cpp with the build's flags (-O3 -DNDEBUG) and
-    runs it: it counts every operator new and malloc during 10^4 updates with 7 x 43 blocks (and
-    blocks of 1..24 rows) and exits non-zero on any. Skipped only without a C++ compiler."""
-    output = build_and_run(
-        tmp_path, "test_rls_no_allocation", ["recursive_least_squares"], optimisation="-O3"
-    )
+def test_update_makes_no_heap_allocation(cpp_tests, record_property):
+    """Runs tests/cpp/test_rls_no_allocation.cpp (built against the installed package): it
+    counts every operator new and malloc during 10^4 updates with 7 x 43 blocks (and blocks of
+    1..24 rows) and exits non-zero on any. Skipped only without a C++ compiler."""
+    output = cpp_tests.run("rls_no_allocation")
     assert re.search(r"^allocations_during_updates=0$", output, re.MULTILINE), output
     timing = re.search(r"us_per_update_median=([0-9.]+)", output)
     assert timing, output

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 
 import dynid
-from cpp_programs import build_and_run
 from dynid.sim import (
     PD,
     ComputedTorque,
@@ -443,29 +442,11 @@ def test_the_documented_example_runs():
 
 # --- C++: no allocation per step ----------------------------------------------------------------
 
-# The sources the simulator and its controllers need.
-CORE_SOURCES = (
-    "simulator",
-    "controllers",
-    "rnea",
-    "crba",
-    "gravity",
-    "kinematics",
-    "model",
-    "workspace",
-    "rigid_body",
-    "energy",
-    "argument_checks",
-    # the vectorised sin/cos of the joint transforms (2-lane path, no special flags)
-    "batch_dispatch",
-    "batch_lanes_sse2",
-)
 
-
-def test_simulator_runs_make_no_heap_allocation(tmp_path):
-    """Compiles tests/cpp/test_simulator_no_allocation.cpp (-O2 -DNDEBUG) and runs it: every
-    operator new and malloc is counted during runs with each built-in controller, both
+def test_simulator_runs_make_no_heap_allocation(cpp_tests):
+    """Runs tests/cpp/test_simulator_no_allocation.cpp (built against the installed package):
+    every operator new and malloc is counted during runs with each built-in controller, both
     integrators, friction, noise and an encoder; it also checks the runs (energy, tracking)."""
-    output = build_and_run(tmp_path, "test_simulator_no_allocation", CORE_SOURCES)
+    output = cpp_tests.run("simulator_no_allocation")
     assert re.search(r"^allocations_during_runs=0$", output, re.MULTILINE), output
     assert re.search(r"^allocations_total=0$", output, re.MULTILINE), output

@@ -32,7 +32,6 @@ import pytest
 import dynid
 from conftest import ARM_CASES, make_arm, random_state
 from coupled_robots import coupled_puma
-from cpp_programs import build_and_run
 from dynid import _core
 
 # bench/pinocchio_arm.py: the Pinocchio model of a dynid DH arm, built without dynid's code
@@ -389,11 +388,11 @@ def test_coupled_batches_equal_single_calls_on_every_batch_path(isa, rng) -> Non
         )
 
 
-def test_no_heap_allocation_per_call_with_a_coupled_transmission(tmp_path) -> None:
-    """Compiles tests/cpp/test_transmission_no_allocation.cpp with the core's sources and runs
-    it: 10^4 calls of every algorithm with drive terms on a coupled arm, no allocation; bad
+def test_no_heap_allocation_per_call_with_a_coupled_transmission(cpp_tests) -> None:
+    """Runs tests/cpp/test_transmission_no_allocation.cpp (built against the installed package):
+    10^4 calls of every algorithm with drive terms on a coupled arm, no allocation; bad
     transmissions are std::invalid_argument naming it."""
-    output = build_and_run(tmp_path, "test_transmission_no_allocation", optimisation="-O1")
+    output = cpp_tests.run("transmission_no_allocation")
     assert re.search(r"^allocations_during_calls=0$", output, re.MULTILINE), output
 
 

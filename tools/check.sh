@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Lint, format, type and stub checks for CI and before a commit (the same as the pre-commit
-# hooks, on the whole tree). Installs the pinned tools of the `dev` extra into the active
+# hooks, on the whole tree). Installs the pinned tools of requirements/dev.txt into the active
 # environment (not the package itself: the type stub check imports the installed dynid).
 #   bash tools/check.sh              # install the tools, then check
 #   bash tools/check.sh --no-install # tools already installed
@@ -8,24 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 if [[ "${1:-}" != "--no-install" ]]; then
-  requirements=$(mktemp)
-  # The dev extra of pyproject.toml (tomllib from Python 3.11 on, a plain parse before).
-  python - >"$requirements" <<'PY'
-import re
-from pathlib import Path
-
-text = Path("pyproject.toml").read_text()
-try:
-    import tomllib
-
-    dev = tomllib.loads(text)["project"]["optional-dependencies"]["dev"]
-except ImportError:
-    block = re.search(r"^dev = \[(.*?)^\]", text, re.S | re.M).group(1)
-    dev = re.findall(r'^\s*"([^"]+)"', block, re.M)
-print("\n".join(dev))
-PY
-  python -m pip install -q -r "$requirements"
-  rm -f "$requirements"
+  python -m pip install -q -r requirements/dev.txt
 fi
 
 targets=(python tests bench tools examples)
