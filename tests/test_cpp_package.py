@@ -18,15 +18,12 @@ from __future__ import annotations
 
 import importlib.metadata
 import json
-import os
 import re
 import subprocess
 from pathlib import Path
 
-import pytest
-
 import dynid.cmake
-from cpp_programs import REPO, find_compiler, find_tool
+from cpp_programs import REPO, find_tool, require_build_tools
 
 EXAMPLES = REPO / "cpp" / "examples"
 
@@ -65,15 +62,7 @@ def test_installed_package_has_headers_library_and_cmake_config():
 
 
 def test_realtime_example_builds_with_find_package_and_never_allocates(tmp_path, record_property):
-    compiler = find_compiler()
-    cmake = find_tool("cmake")
-    if compiler is None or cmake is None:
-        # In CI the zero-allocation proof must run, not be skipped.
-        assert not os.environ.get("CI"), f"CI needs a C++ compiler and cmake: {compiler}, {cmake}"
-        pytest.skip(
-            "needs a C++ compiler (CXX, g++, c++, clang++) and cmake (PATH or "
-            f"`pip install cmake`): compiler={compiler}, cmake={cmake}"
-        )
+    compiler, cmake, _ = require_build_tools()
     build = tmp_path / "build"
     configure = [
         cmake,
