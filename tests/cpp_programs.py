@@ -87,16 +87,8 @@ class CppTests:
         """Run one program of the build; it must exit 0 without a sanitizer report. Returns its
         standard output and error."""
         assert program in PROGRAMS, program
-        done = subprocess.run(
-            [str(self.build / program), *arguments],
-            capture_output=True,
-            text=True,
-            timeout=600,
-            check=False,
-            env={**os.environ, **SANITIZER_OPTIONS},
-        )
-        output = done.stdout + done.stderr
-        assert done.returncode == 0, output
+        command = [str(self.build / program), *arguments]
+        output = run_tool(command, timeout=600, env={**os.environ, **SANITIZER_OPTIONS})
         assert not SANITIZER_REPORT.search(output), output
         return output
 
@@ -111,36 +103,49 @@ SANITIZER_REPORT = re.compile(
 )
 
 
+def run_tool(command: list[str], timeout: float = 900, env: dict[str, str] | None = None) -> str:
+    """Run a build or test tool (cmake, ctest, a program); it must exit 0. Its output."""
+    done = subprocess.run(
+        command, capture_output=True, text=True, timeout=timeout, check=False, env=env
+    )
+    output = done.stdout + done.stderr
+    assert done.returncode == 0, f"{command}:\n{output}"
+    return output
+
+
+def cmake_configure(source: Path, build: Path, *options: str) -> str:
+    """``cmake -S source -B build`` with this machine's compiler (Ninja when there is one),
+    compile_commands.json written; returns CMake's output."""
+    compiler, cmake, _ = require_build_tools()
+    command = [cmake, "-S", str(source), "-B", str(build), f"-DCMAKE_CXX_COMPILER={compiler}"]
+    command += ["-DCMAKE_EXPORT_COMPILE_COMMANDS=ON", *options]
+    ninja = find_tool("ninja")
+    if ninja:
+        command += ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"]
+    return run_tool(command, timeout=300)
+
+
+def cmake_build(build: Path) -> str:
+    """Build every target of ``build`` on every core."""
+    _, cmake, _ = require_build_tools()
+    return run_tool([cmake, "--build", str(build), "--parallel", str(os.cpu_count() or 1)])
+
+
+def compile_commands(build: Path) -> list[str]:
+    """The compiler command of every file of a configured build."""
+    entries = json.loads((build / "compile_commands.json").read_text())
+    return [e.get("command") or " ".join(e["arguments"]) for e in entries]
+
+
 def build_cpp_tests(folder: Path) -> CppTests:
     """Configure tests/cpp against the installed dynid in ``folder`` and build every program."""
     import dynid.cmake
 
-    compiler, cmake, ctest = require_build_tools()
-    configure = [
-        cmake,
-        "-S",
-        str(REPO / "tests" / "cpp"),
-        "-B",
-        str(folder),
-        f"-Ddynid_DIR={dynid.cmake.get_cmake_dir()}",
-        f"-DCMAKE_CXX_COMPILER={compiler}",
-        "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON",
-    ]
-    ninja = find_tool("ninja")
-    if ninja:
-        configure += ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"]
-    step = subprocess.run(configure, capture_output=True, text=True, timeout=300, check=False)
-    assert step.returncode == 0, step.stdout + step.stderr
-    configured = step.stdout
-    step = subprocess.run(
-        [cmake, "--build", str(folder), "--parallel", str(os.cpu_count() or 1)],
-        capture_output=True,
-        text=True,
-        timeout=900,
-        check=False,
+    configured = cmake_configure(
+        REPO / "tests" / "cpp", folder, f"-Ddynid_DIR={dynid.cmake.get_cmake_dir()}"
     )
-    assert step.returncode == 0, step.stdout + step.stderr
-    return CppTests(folder, "sanitizers ON" in configured, configured, ctest)
+    cmake_build(folder)
+    return CppTests(folder, "sanitizers ON" in configured, configured, require_build_tools()[2])
 
 
 def shared_build(folder: Path) -> CppTests:

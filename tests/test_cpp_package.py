@@ -17,13 +17,11 @@ Skipped only when no C++ compiler or no cmake is found.
 from __future__ import annotations
 
 import importlib.metadata
-import json
 import re
-import subprocess
 from pathlib import Path
 
 import dynid.cmake
-from cpp_programs import REPO, find_tool, require_build_tools
+from cpp_programs import REPO, cmake_build, cmake_configure, compile_commands, run_tool
 
 EXAMPLES = REPO / "cpp" / "examples"
 
@@ -62,54 +60,27 @@ def test_installed_package_has_headers_library_and_cmake_config():
 
 
 def test_realtime_example_builds_with_find_package_and_never_allocates(tmp_path, record_property):
-    compiler, cmake, _ = require_build_tools()
     build = tmp_path / "build"
-    configure = [
-        cmake,
-        "-S",
-        str(EXAMPLES),
-        "-B",
-        str(build),
-        f"-DCMAKE_PREFIX_PATH={dynid.cmake.get_cmake_dir()}",
+    cmake_configure(
+        EXAMPLES, build, f"-DCMAKE_PREFIX_PATH={dynid.cmake.get_cmake_dir()}",
         "-DCMAKE_BUILD_TYPE=Release",
-        f"-DCMAKE_CXX_COMPILER={compiler}",
-        "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON",
-    ]
-    ninja = find_tool("ninja")
-    if ninja:
-        configure += ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"]
-    step = subprocess.run(configure, capture_output=True, text=True, timeout=300, check=False)
-    assert step.returncode == 0, step.stdout + step.stderr
-    step = subprocess.run(
-        [cmake, "--build", str(build), "--config", "Release"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert step.returncode == 0, step.stdout + step.stderr
+    )  # fmt: skip
+    cmake_build(build)
 
     # The example was compiled against the installed headers, not the source tree's.
-    commands = json.loads((build / "compile_commands.json").read_text())
-    command = commands[0].get("command") or " ".join(commands[0]["arguments"])
+    command = compile_commands(build)[0]
     assert dynid.cmake.get_include() in command, command
     assert str(REPO / "cpp" / "include") not in command, command
 
     program = build / "realtime_loop"
     if not program.is_file():  # multi-configuration generators
         program = build / "Release" / "realtime_loop"
-    run = subprocess.run(
-        [str(program), "2"], capture_output=True, text=True, timeout=300, check=False
-    )
-    output = run.stdout + run.stderr
+    output = run_tool([str(program), "2"], timeout=300)
     print(output)
-    assert run.returncode == 0, output
-    assert re.search(r"^allocations: 0 allocations in 2000 cycles", run.stdout, re.MULTILINE), (
-        output
-    )
+    assert re.search(r"^allocations: 0 allocations in 2000 cycles", output, re.MULTILINE), output
 
     def number(pattern: str) -> float:
-        match = re.search(pattern, run.stdout)
+        match = re.search(pattern, output)
         assert match, f"{pattern!r} not in the output:\n{output}"
         return float(match.group(1))
 

@@ -17,13 +17,19 @@ Skipped only without a C++ compiler or cmake, and then failed instead when CI is
 
 from __future__ import annotations
 
-import json
 import os
 import re
-import subprocess
 
 import dynid.cmake
-from cpp_programs import PROGRAMS, REPO, SANITIZER_REPORT, CppTests, find_compiler
+from cpp_programs import (
+    PROGRAMS,
+    REPO,
+    SANITIZER_REPORT,
+    CppTests,
+    compile_commands,
+    find_compiler,
+    run_tool,
+)
 
 
 def test_cpp_tests_pass_under_address_and_undefined_sanitizers(
@@ -36,8 +42,7 @@ def test_cpp_tests_pass_under_address_and_undefined_sanitizers(
 
     # The programs were compiled against the installed headers with the sanitizers and with the
     # Eigen settings of the installed core, which come from the exported target.
-    for entry in json.loads((cpp_tests.build / "compile_commands.json").read_text()):
-        command = entry.get("command") or " ".join(entry["arguments"])
+    for command in compile_commands(cpp_tests.build):
         assert dynid.cmake.get_include() in command, command
         assert str(REPO / "cpp" / "include") not in command, command
         assert "-DEIGEN_MALLOC_ALREADY_ALIGNED=" in command, command
@@ -45,15 +50,9 @@ def test_cpp_tests_pass_under_address_and_undefined_sanitizers(
         if cpp_tests.sanitized:
             assert "-fsanitize=address,undefined" in command, command
 
-    run = subprocess.run(
-        [cpp_tests.ctest, "--test-dir", str(cpp_tests.build), "--output-on-failure", "-V"],
-        capture_output=True,
-        text=True,
-        timeout=900,
-        check=False,
+    output = run_tool(
+        [cpp_tests.ctest, "--test-dir", str(cpp_tests.build), "--output-on-failure", "-V"]
     )
-    output = run.stdout + run.stderr
-    assert run.returncode == 0, output
     assert not SANITIZER_REPORT.search(output), output
     assert f"100% tests passed out of {len(PROGRAMS)}" in output, output
     assert re.search(r"size checks: (\d+) probes, 0 failures", output), output
