@@ -132,12 +132,71 @@ def test_wls_matches_weighted_normal_equations():
     np.testing.assert_allclose(result.residual_rms, rms, rtol=1e-10)
 
 
-def test_single_sample_is_one_time_step():
+# --- a stacked system Y (N, p), tau (N,): one group, one noise level (issue 22) -------------------
+
+
+def stacked_problem(seed: int, N: int = 200, p: int = 6, sigma: float = 0.3):
+    """A fixed, well-conditioned A (N, p) and theta; b with homoscedastic noise of the seed."""
+    A = np.random.default_rng(0).normal(size=(N, p))
+    theta = np.linspace(-1.0, 2.0, p)
+    return A, theta, A @ theta + np.random.default_rng(seed).normal(size=N) * sigma
+
+
+@pytest.mark.parametrize("method", ["ols", "wls"])
+def test_a_stacked_y_is_one_system_with_one_noise_level(method):
+    # Independent: lstsq and sigma^2 (A^T A)^-1 with sigma^2 = ||r||^2 / (N - p), one variance.
+    A, _, b = stacked_problem(5)
+    N, p = A.shape
+    theta, *_ = np.linalg.lstsq(A, b, rcond=None)
+    r = b - A @ theta
+    variance = r @ r / (N - p)
+    result = least_squares(A, b, method=method)
+    np.testing.assert_allclose(result.theta, theta, rtol=1e-10)
+    np.testing.assert_allclose(
+        result.std, np.sqrt(variance * np.diag(np.linalg.inv(A.T @ A))), rtol=1e-10
+    )
+    np.testing.assert_allclose(result.noise_variance, [variance], rtol=1e-10)
+    np.testing.assert_allclose(result.residual_rms, [np.sqrt(r @ r / N)], rtol=1e-10)
+    assert result.joints == (0,) and result.excluded == ()
+    np.testing.assert_allclose(result.predict(A), A @ result.theta, rtol=1e-14)
+    # The explicit form of the same system: one joint of N samples. Same path, same numbers.
+    explicit = least_squares(A[:, np.newaxis], b[:, np.newaxis], method=method)
+    assert explicit == result
+
+
+def test_a_stacked_y_equals_the_per_joint_form_under_ols():
+    # OLS pools the noise whatever the groups: the (T, n, p) form and its stack_by_joint agree.
+    Y, tau = random_problem(14)
+    A, b, _ = stack_by_joint(Y, tau)
+    per_joint, stacked = least_squares(Y, tau), least_squares(A, b)
+    np.testing.assert_allclose(stacked.theta, per_joint.theta, rtol=1e-10)
+    np.testing.assert_allclose(stacked.std, per_joint.std, rtol=1e-10)
+    np.testing.assert_allclose(stacked.covariance, per_joint.covariance, rtol=1e-10, atol=1e-16)
+    (T, _, p), N = Y.shape, b.size
+    pooled = np.sum(per_joint.residual_rms**2) * T / (N - p)  # ||r||^2 / (N - p)
+    np.testing.assert_allclose(stacked.noise_variance, [pooled], rtol=1e-10)
+
+
+@pytest.mark.parametrize("method", ["ols", "wls"])
+def test_stacked_std_is_calibrated_on_homoscedastic_data(method):
+    # 200 noise draws x 6 parameters: the z-scores (theta - theta_true) / std of a calibrated std
+    # have RMS ~1 (t with 194 dof: 1.005). Read as one sample of 200 joints, every row had its own
+    # noise variance and the WLS z-scores an RMS of 9.7.
+    z = []
+    for seed in range(200):
+        A, theta_true, b = stacked_problem(seed)
+        fit = least_squares(A, b, method=method)
+        z.append((fit.theta - theta_true) / fit.std)
+    rms = np.sqrt(np.mean(np.square(z)))
+    assert 0.8 <= rms <= 1.2, rms
+
+
+def test_one_sample_of_n_joints_is_the_per_joint_form_with_t_1():
     rng = np.random.default_rng(5)
-    Y, tau = rng.normal(size=(8, 3)), rng.normal(size=8)
+    Y, tau = rng.normal(size=(1, 8, 3)), rng.normal(size=8)
     result = least_squares(Y, tau)
-    np.testing.assert_allclose(result.theta, np.linalg.lstsq(Y, tau, rcond=None)[0], rtol=1e-10)
-    np.testing.assert_allclose(result.predict(Y), Y @ result.theta, rtol=1e-14)
+    np.testing.assert_allclose(result.theta, np.linalg.lstsq(Y[0], tau, rcond=None)[0], rtol=1e-10)
+    assert result.joints == tuple(range(8))
 
 
 def test_no_degrees_of_freedom_left_warns_and_reports_infinite_std():
@@ -250,7 +309,7 @@ def test_rank_deficient_data_raise_naming_the_parameter(same_q2):
     with pytest.raises(RankDeficientError, match=r"theta\[0\]"):  # unnamed: indices
         least_squares(Y, tau, exclude_joints=(0,))
     with pytest.raises(RankDeficientError, match="rows"):  # one sample: 6 rows < 12 parameters
-        least_squares(Y[0], tau[0], exclude_joints=(0,), on_rank_deficient="warn")
+        least_squares(Y[:1], tau[:1], exclude_joints=(0,), on_rank_deficient="warn")
 
 
 def test_unexcited_column_is_named():
@@ -312,7 +371,11 @@ GOOD_Y, GOOD_TAU = random_problem(13)
     ("kwargs", "argument"),
     [
         ({"Y": np.where(GOOD_Y[0, 0, 0] == GOOD_Y, np.nan, GOOD_Y)}, "Y"),
-        ({"Y": GOOD_Y[:, :, 0]}, "tau"),  # (T, n) Y is one sample of T joints: tau mismatch
+        ({"Y": GOOD_Y[:, :, 0]}, "tau"),  # (T, n) Y is a stacked system of T rows: tau (T,)
+        ({"Y": GOOD_Y[:, 0], "tau": GOOD_TAU[:, :1]}, "tau"),
+        ({"Y": GOOD_Y[:0, 0], "tau": GOOD_TAU[:0, 0]}, "Y"),
+        ({"Y": GOOD_Y[:, 0], "tau": GOOD_TAU[:, 0], "exclude_joints": (0,)}, "exclude_joints"),
+        ({"Y": GOOD_Y[:, 0], "tau": GOOD_TAU[:, 0], "exclude_joints": 0}, "exclude_joints"),
         ({"Y": GOOD_Y[0, 0]}, "Y"),
         ({"Y": "abc"}, "Y"),
         ({"tau": np.where(GOOD_TAU[0, 0] == GOOD_TAU, np.inf, GOOD_TAU)}, "tau"),

@@ -3,14 +3,22 @@ the textbook formulas evaluated directly on the stacked matrix (lecture p. 27): 
 the estimate, sigma^2 pinv(A) pinv(A)^T for the OLS covariance, the WLS weights from the per-joint
 OLS residuals. Tolerance 1e-9 relative (the issue's contract) on theta, std, the noise variances
 and the residual RMS; the rank-deficient error is the same as least_squares'.
+
+The factors are kept in power-of-two units that grow with the largest value seen so far; chunks
+whose scales differ (issue 22: a first chunk with max |Y| or max |tau| in [0.5, 1), whose exponent
+is 0, followed by larger ones) are checked against a closed form and, on random scales and
+chunkings, against numpy's lstsq on the stacked rows.
 """
 
 from __future__ import annotations
 
+import hypothesis.strategies as st
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
 
 import dynid
+from dynid import identify
 from dynid.identify import RankDeficientError, stack_by_joint
 
 RTOL = 1e-9
@@ -139,3 +147,126 @@ def test_streaming_rank_deficiency_and_bad_input_are_named():
         dynid.least_squares_streaming(robot, [(q, qd, qdd, tau)], columns=[0, 91])
     with pytest.raises(ValueError, match="n: expected an integer >= 1"):
         dynid.LeastSquaresAccumulator(0, 3)
+
+
+# --- scales: chunks of different magnitudes (issue 22) ------------------------------------------
+
+
+def one_parameter_fit(y: np.ndarray, tau: np.ndarray) -> tuple[float, float]:
+    """theta = sum(y tau) / sum(y^2) and the residual norm of tau = y theta (closed form)."""
+    theta = float(y @ tau / (y @ y))
+    return theta, float(np.linalg.norm(tau - y * theta))
+
+
+@pytest.mark.parametrize(
+    ("first", "later"),
+    [
+        # (y, tau) rows of the first chunk, then of a later one; exponent 0 means max in [0.5, 1)
+        (([0.75, -0.5], [1.6, -1.0]), ([3.0, 5.0], [6.4, 10.6])),  # max |Y| exponent 0
+        (([0.3, -0.2], [0.64, -0.45]), ([3.0, 5.0], [6.4, 10.6])),  # max |tau| exponent 0
+        (([0.75, 0.5], [0.9, 0.6]), ([3.0, 5.0], [6.4, 10.6])),  # both
+        (([0.75, 0.5], [1.6, 1.0]), ([-(2.0**40), 3.0], [-2.13 * 2.0**40, 6.0])),  # far larger
+    ],
+)
+def test_a_first_chunk_below_one_keeps_its_scale_when_later_chunks_are_larger(first, later):
+    y = np.concatenate([first[0], later[0]])
+    tau = np.concatenate([first[1], later[1]])
+    theta, residual = one_parameter_fit(y, tau)
+    acc = dynid.LeastSquaresAccumulator(1, 1)
+    for rows, torques in (first, later):
+        acc.add(np.reshape(rows, (-1, 1, 1)), np.reshape(torques, (-1, 1)))
+    fit = acc.solve()
+    assert fit.theta[0] == pytest.approx(theta, rel=1e-14)
+    # A residual norm is computed to about eps ||tau|| (cancellation in tau - y theta).
+    residual_error = abs(fit.residual_rms[0] * np.sqrt(y.size) - residual)
+    assert residual_error <= 1e-14 * np.linalg.norm(tau)
+
+
+def test_the_issue_example_one_parameter_streaming_returns_the_exact_value():
+    # Consistent rows (tau = 2.13 y) in two chunks, the first with max |Y| = 0.75: 2.13 whatever
+    # the weighting, up to rounding.
+    acc = dynid.LeastSquaresAccumulator(1, 1)
+    acc.add(np.full((3, 1, 1), 0.75), np.full((3, 1), 2.13 * 0.75))
+    acc.add(np.full((3, 1, 1), 6.0), np.full((3, 1), 2.13 * 6.0))
+    assert acc.solve().theta[0] == pytest.approx(2.13, rel=1e-14)
+
+
+@pytest.mark.parametrize("method", ["ols", "wls"])
+def test_least_squares_keeps_the_scale_of_its_first_internal_chunk(method):
+    # least_squares folds CHUNK_SAMPLES samples at a time: the first chunk's values are in
+    # [0.5, 1), the second's 2^10 times larger. Closed form per parameter (p = 1, one joint).
+    T = identify.CHUNK_SAMPLES
+    rng = np.random.default_rng(22)
+    y = np.concatenate([rng.uniform(0.5, 0.99, T), rng.uniform(0.5, 0.99, T) * 2.0**10])
+    tau = 2.13 * y + rng.normal(scale=0.01, size=2 * T) * np.abs(y)
+    theta, residual = one_parameter_fit(y, tau)
+    fit = dynid.least_squares(y[:, None, None], tau[:, None], method=method)
+    assert fit.theta[0] == pytest.approx(theta, rel=1e-12)
+    assert fit.residual_rms[0] * np.sqrt(y.size) == pytest.approx(residual, rel=1e-10)
+
+
+#: Random problems: derandomized (the same examples every run) and no example database on disk.
+SCALES = settings(
+    max_examples=80,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+
+#: Power-of-two exponents of the whole Y and tau: 0 (max in [0.5, 1)) often, and a wide range.
+EXPONENTS = st.sampled_from([0, -1, 1]) | st.integers(-60, 60)
+
+
+@st.composite
+def scaled_problems(draw):
+    """A well-conditioned Gaussian problem Y (T, n, p), tau (T, n), cut into chunks of samples
+    whose max |Y| has the power-of-two exponent a + shift_k exactly (rows scaled by powers of
+    two, Y and tau alike, so the model still holds), tau scaled by 2^b."""
+    p = draw(st.integers(1, 5))
+    n = draw(st.integers(1, 3))
+    sizes = draw(st.lists(st.integers(1, 12), min_size=1, max_size=6))
+    sizes.append(draw(st.integers(2 * p + 4, 2 * p + 20)))  # enough rows in every case
+    if draw(st.booleans()):
+        sizes.reverse()
+    a, b = draw(EXPONENTS), draw(EXPONENTS)
+    shifts = draw(st.lists(st.integers(-3, 3), min_size=len(sizes), max_size=len(sizes)))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    theta = rng.normal(size=p)
+    chunks = []
+    for size, shift in zip(sizes, shifts):
+        Y = rng.normal(size=(size, n, p))
+        tau = Y @ theta + rng.normal(scale=0.3, size=(size, n))
+        # Row scale: max |Y| becomes 2^(a + shift) times a value in [0.5, 1).
+        row = np.ldexp(1.0, a + shift - int(np.frexp(np.abs(Y).max())[1]))
+        chunks.append((Y * row, np.ldexp(tau * row, b - a)))
+    return chunks
+
+
+def relative_error(actual, expected) -> float:
+    return float(np.linalg.norm(actual - expected) / np.linalg.norm(expected))
+
+
+@SCALES
+@given(chunks=scaled_problems())
+def test_streaming_matches_lstsq_on_random_scales_and_chunkings(chunks):
+    Y = np.concatenate([c[0] for c in chunks])
+    tau = np.concatenate([c[1] for c in chunks])
+    A, b, group = stack_by_joint(Y, tau)
+    # The reference in units where the exponents are small (exact powers of two), so that
+    # lstsq's own arithmetic cannot underflow or overflow.
+    a = int(np.frexp(np.abs(A).max())[1])
+    e = int(np.frexp(np.abs(b).max())[1])
+    theta, *_ = np.linalg.lstsq(np.ldexp(A, -a), np.ldexp(b, -e), rcond=None)
+    assert np.linalg.cond(np.ldexp(A, -a)) < 1e4  # well conditioned: 1e-9 is attainable
+    theta = np.ldexp(theta, e - a)
+    r = b - A @ theta
+    norms = np.array([np.linalg.norm(r[group == j]) for j in np.unique(group)])
+
+    acc = dynid.LeastSquaresAccumulator(Y.shape[1], Y.shape[2])
+    for Y_k, tau_k in chunks:
+        acc.add(Y_k, tau_k)
+    fit = acc.solve()
+    assert relative_error(fit.theta, theta) <= 1e-9
+    assert relative_error(fit.residual_rms * np.sqrt(Y.shape[0]), norms) <= 1e-9

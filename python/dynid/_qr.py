@@ -79,16 +79,22 @@ class GroupedTriangularFactors:
 
     def _rescale(self, a_new: int | None, b_new: int | None) -> None:
         """Raises the scaling exponents to a chunk's, rescaling the factors so far (exactly)."""
-        if a_new is not None and (self.a_exp is None or a_new > self.a_exp):
-            shift = (self.a_exp or a_new) - a_new if self.samples else 0
+        self.a_exp = self._raised(self.a_exp, a_new, slice(0, self.p))
+        self.b_exp = self._raised(self.b_exp, b_new, self.p)
+
+    def _raised(self, old: int | None, new: int | None, columns: slice | int) -> int | None:
+        """max(old, new), the factors' ``columns`` moved from units 2^old to 2^new if it grows.
+
+        None means no non-zero value yet (those columns of the factors are all zero, so there is
+        nothing to rescale). The tests are on None, never on truthiness: 0 is the exponent of
+        values in [0.5, 1) (issue 22: ``old or new`` skipped the rescaling for it).
+        """
+        if new is None or (old is not None and new <= old):
+            return old
+        if old is not None:
             for R in self.factors.values():
-                R[:, : self.p] = np.ldexp(R[:, : self.p], shift)
-            self.a_exp = a_new
-        if b_new is not None and (self.b_exp is None or b_new > self.b_exp):
-            shift = (self.b_exp or b_new) - b_new if self.samples else 0
-            for R in self.factors.values():
-                R[:, self.p] = np.ldexp(R[:, self.p], shift)
-            self.b_exp = b_new
+                R[:, columns] = np.ldexp(R[:, columns], old - new)
+        return new
 
     def combined(self, weights: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The R of the whole stacked [A | b], joint j's rows multiplied by weights[k] (k-th

@@ -124,7 +124,16 @@ def least_squares(
 ) -> LeastSquaresResult:
     """Estimate theta in Y theta = tau by ordinary or weighted least squares (lecture p. 27).
 
-    The rows are stacked by :func:`stack_by_joint` (N rows, p columns, N_j rows of joint j).
+    Two forms of input:
+
+    - per joint: ``Y`` (T, n, p) and ``tau`` (T, n), T samples of an n-joint model. The rows are
+      stacked by :func:`stack_by_joint` (N = T n rows minus the excluded joints', p columns,
+      N_j rows of joint j); each joint is a group with its own noise level for WLS. One sample
+      is ``Y[np.newaxis]`` (1, n, p) with ``tau`` (1, n) or (n,).
+    - stacked: ``Y`` (N, p) and ``tau`` (N,), one system of N rows with one noise level, as for
+      numpy.linalg.lstsq; identical to ``Y[:, np.newaxis]``, ``tau[:, np.newaxis]`` (one joint,
+      N samples). There is a single group, so ``method="wls"`` has a single sigma and gives the
+      estimate and covariance of OLS; ``exclude_joints`` must be empty.
 
     ``method="ols"``: theta minimises ||b - A theta||; covariance sigma^2 (A^T A)^-1 with
     sigma^2 = ||r||^2 / (N - p), with (A^T A)^-1 = D^-1 V S^-2 V^T D^-1 from the factors
@@ -144,7 +153,7 @@ def least_squares(
 
     ``noise_variance`` holds the sigma_j^2 above (before the floor) for both methods, and
     ``residual_rms`` the per-joint RMS residual of the final fit, in torque units; both follow
-    ``joints``, the kept joints in increasing order.
+    ``joints``, the kept joints in increasing order (a stacked Y: one entry, ``joints == (0,)``).
 
     Rank (lecture p. 28, "numerical check of full column rank"): the number of singular values of
     the column-scaled matrix above ``rank_tolerance`` times the largest. When it is below p,
@@ -164,8 +173,7 @@ def least_squares(
     (van der Sluis), and can be much smaller than this one.
     """
     method, on_rank_deficient = _check_options(method, on_rank_deficient, rank_tolerance)
-    Y, tau = _samples(Y, tau)
-    excluded = tuple(sorted(_excluded(exclude_joints, Y.shape[1])))
+    Y, tau, excluded = _grouped(Y, tau, exclude_joints)
     T, n, p = Y.shape
     factors = GroupedTriangularFactors(n, p, tuple(j for j in range(n) if j not in excluded))
     for begin in range(0, T, CHUNK_SAMPLES):  # bounded scratch memory, whatever T
@@ -323,6 +331,42 @@ def _rank_message(rank: int, p: int, null: NDArray[np.float64], names: list[str]
         "the data). Use more varied data (more configurations, different values of every "
         "joint, richer velocities and accelerations)."
     )
+
+
+def _grouped(
+    Y: ArrayLike, tau: ArrayLike, exclude_joints: Sequence[int]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[int, ...]]:
+    """least_squares' input as Y (T, n, p), tau (T, n) and the excluded joints (sorted)."""
+    Y = _finite(Y, "Y")
+    if Y.ndim == 2:
+        Y, tau = _stacked(Y, tau, exclude_joints)
+        return Y, tau, ()
+    Y, tau = _samples(Y, tau)
+    return Y, tau, tuple(sorted(_excluded(exclude_joints, Y.shape[1])))
+
+
+def _stacked(
+    Y: NDArray[np.float64], tau: ArrayLike, exclude_joints: Sequence[int]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A stacked system Y (N, p), tau (N,) as one joint of N samples: (N, 1, p), (N, 1).
+
+    One group, so one noise level: read as one sample of N joints, every row would be its own
+    group, with its own 1-row QR factor and (for WLS) its own noise variance (issue 22).
+    """
+    if 0 in Y.shape:
+        raise ValueError(f"Y: expected a non-empty (N, p) or (T, n, p) array, got shape {Y.shape}")
+    tau = _finite(tau, "tau")
+    if tau.shape != Y.shape[:1]:
+        raise ValueError(
+            f"tau: expected shape ({Y.shape[0]},) to match the stacked Y {Y.shape}, got {tau.shape}"
+        )
+    empty = not isinstance(exclude_joints, (str, bytes)) and np.size(exclude_joints) == 0
+    if not empty:
+        raise ValueError(
+            f"exclude_joints: a stacked Y (N, p) has no joints to exclude, got "
+            f"{exclude_joints!r}; pass Y (T, n, p) and tau (T, n) to leave joints out"
+        )
+    return Y[:, np.newaxis, :], tau[:, np.newaxis]
 
 
 def _samples(Y: ArrayLike, tau: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
