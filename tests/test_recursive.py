@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import copy
 import re
+import threading
 from collections.abc import Callable
 from pathlib import Path
 
@@ -477,3 +478,34 @@ def test_update_makes_no_heap_allocation(cpp_tests, record_property):
     # Reported, not asserted (the machine may be busy): the target is < 10 us per update.
     record_property("us_per_update", float(timing.group(1)))
     print(output)
+
+
+def test_one_estimator_shared_by_two_threads_runs_the_batches_one_after_the_other():
+    """update_batch releases the GIL: two threads updating one estimator must not interleave
+    (issue 22). The result is exactly that of the two batches in one of the two orders."""
+    rng = np.random.default_rng(20261126)
+    p, m, T = 43, 7, 20_000
+    batches = [(rng.normal(size=(T, m, p)), rng.normal(size=(T, m))) for _ in range(2)]
+    orders = []
+    for order in ((0, 1), (1, 0)):
+        serial = dynid.RecursiveLeastSquares(p)
+        for k in order:
+            serial.update_batch(*batches[k])
+        orders.append(serial.theta)
+
+    shared = dynid.RecursiveLeastSquares(p)
+    start = threading.Barrier(2)
+
+    def worker(k: int) -> None:
+        start.wait()
+        shared.update_batch(*batches[k])
+
+    threads = [threading.Thread(target=worker, args=(k,)) for k in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert any(np.array_equal(shared.theta, theta) for theta in orders), (
+        np.abs(shared.theta - orders[0]).max(),
+        np.abs(shared.theta - orders[1]).max(),
+    )

@@ -13,6 +13,7 @@
 #include "arrays.hpp"
 #include "batch.hpp"
 #include "dynid/recursive_least_squares.hpp"
+#include "object_lock.hpp"
 
 namespace dynid::binding {
 namespace {
@@ -137,6 +138,7 @@ void update(RLS& rls, py::handle Y_obj, py::handle tau_obj) {
   // The state before the update, kept in a per-thread copy that is only resized when p changes
   // (a plain copy would allocate ten Eigen objects per call, +20% on a 43-parameter update).
   thread_local std::optional<RLS> before;
+  const auto lock = lock_object(&rls);
   if (before && before->p() == p)
     *before = rls;
   else
@@ -174,6 +176,7 @@ py::array update_batch(RLS& rls, py::handle Y_obj, py::handle tau_obj, py::handl
   double* out = thetas.mutable_data();
   const double* Y_data = Y.data();
   const double* tau_data = tau.data();
+  const auto lock = lock_object(&rls);  // the whole batch, one thread at a time
   // The updates are sequential: one thread, chunks of blocks between Ctrl-C checks (batch.hpp).
   // An interrupted or overflowing batch leaves the estimator as it was before the call.
   const RLS before = rls;
@@ -228,7 +231,8 @@ max_variance : float, optional
     With lambda < 1, cap on the UD variances against covariance windup when the data stop
     exciting some direction; default the largest initial one (c for a number c).
 
-Not thread-safe: use one estimator per thread.)doc";
+Calls on one estimator from several threads run one after the other (a batch update releases
+the GIL but keeps the estimator to itself); use one estimator per thread to run in parallel.)doc";
 
 }  // namespace
 
@@ -254,6 +258,7 @@ void bind_recursive_least_squares(py::module_& m) {
       .def(
           "reset",
           [](RLS& self, py::handle initial_covariance, py::handle theta0) {
+            const auto lock = lock_object(&self);
             if (initial_covariance.is_none() && theta0.is_none()) {
               self.reset();
               return;
@@ -267,12 +272,17 @@ void bind_recursive_least_squares(py::module_& m) {
           "its constructor default (1e6, zeros).")
       .def_property_readonly("p", &RLS::p, "Number of parameters.")
       .def_property_readonly(
-          "theta", [](const RLS& self) { return copy_of(self.theta()); },
+          "theta",
+          [](const RLS& self) {
+            const auto lock = lock_object(&self);
+            return copy_of(self.theta());
+          },
           "Current estimate (p,), a copy.")
       .def_property_readonly(
           "covariance",
           [](const RLS& self) {
             py::array_t<double> P({self.p(), self.p()});
+            const auto lock = lock_object(&self);
             self.covariance(
                 Eigen::Map<MatrixX>(P.mutable_data(), self.p(), self.p()));  // symmetric
             return P;
@@ -290,7 +300,10 @@ void bind_recursive_least_squares(py::module_& m) {
           "initial one).")
       .def(py::pickle(
           [](const RLS& self) {  // __getstate__: everything that defines the estimator
-            const RLS::State st = self.state();
+            const RLS::State st = [&] {
+              const auto lock = lock_object(&self);
+              return self.state();
+            }();
             return py::make_tuple(st.forgetting, st.max_variance, st.max_initial_variance,
                                   copy_of(st.theta), copy_of(st.theta0), copy_of(st.D),
                                   copy_of(st.D0), copy_of_matrix(st.U), copy_of_matrix(st.U0));
@@ -309,9 +322,18 @@ void bind_recursive_least_squares(py::module_& m) {
             st.U0 = matrix_from(t[8], "state.U0");
             return RLS::from_state(st);
           }))
-      .def("__copy__", [](const RLS& self) { return RLS(self); })
+      .def("__copy__",
+           [](const RLS& self) {
+             const auto lock = lock_object(&self);
+             return RLS(self);
+           })
       .def(
-          "__deepcopy__", [](const RLS& self, py::handle) { return RLS(self); }, py::arg("memo"))
+          "__deepcopy__",
+          [](const RLS& self, py::handle) {
+            const auto lock = lock_object(&self);
+            return RLS(self);
+          },
+          py::arg("memo"))
       .def("__repr__", [](const RLS& self) {
         return "RecursiveLeastSquares(p=" + std::to_string(self.p()) +
                ", forgetting=" + std::string(py::str(py::float_(self.forgetting()))) + ")";

@@ -9,6 +9,7 @@
 
 #include "arrays.hpp"
 #include "model.hpp"
+#include "object_lock.hpp"
 
 namespace dynid::binding {
 namespace {
@@ -91,6 +92,8 @@ r tracks the external joint torque J^T F_ext through a first-order filter of tim
 the trapezoidal rule, r implicit (Tustin). The robot's model is copied at construction.
 
 Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample period, s).
+Calls on one observer from several threads run one after the other (run() releases the GIL but
+keeps the observer to itself); use one observer per thread to run in parallel.
 )doc")
       .def(py::init([](PyModel& robot, py::handle gain, py::handle dt) {
              const double period = parse_number(dt, "dt");
@@ -110,13 +113,24 @@ Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample 
                              [](const PyMomentumObserver& self) { return self.observer->dt(); })
       .def_property_readonly(
           "residual",
-          [](const PyMomentumObserver& self) { return vector_copy(self.observer->residual()); },
+          [](const PyMomentumObserver& self) {
+            const auto lock = lock_object(&self);
+            return vector_copy(self.observer->residual());
+          },
           "The last residual r (n,).")
       .def_property_readonly(
-          "samples", [](const PyMomentumObserver& self) { return self.observer->samples(); },
+          "samples",
+          [](const PyMomentumObserver& self) {
+            const auto lock = lock_object(&self);
+            return self.observer->samples();
+          },
           "Samples seen since construction or reset().")
       .def(
-          "reset", [](PyMomentumObserver& self) { self.observer->reset(); },
+          "reset",
+          [](PyMomentumObserver& self) {
+            const auto lock = lock_object(&self);
+            self.observer->reset();
+          },
           "Forget the history: the next sample starts a new integral (r = 0, p(0) = M q̇).")
       .def(
           "update",
@@ -128,6 +142,7 @@ Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample 
                                     ",) (one sample; run() takes a log)");
             py::array_t<double> r(n);
             OutVec out(r.mutable_data(), n);
+            const auto lock = lock_object(&self);
             self.observer->update(ConstVec(s.row(0, 0, n), n), ConstVec(s.row(1, 0, n), n),
                                   ConstVec(s.row(2, 0, n), n), out);
             require_finite_result(r.data(), n, s.names.c_str());
@@ -145,6 +160,7 @@ Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample 
                                     ") (a log; update() takes one sample)");
             py::array_t<double> r({s.count, static_cast<py::ssize_t>(n)});
             double* data = r.mutable_data();
+            const auto lock = lock_object(&self);  // the whole log, one thread at a time
             {
               py::gil_scoped_release release;
               for (py::ssize_t t = 0; t < s.count; ++t) {

@@ -357,6 +357,8 @@ class MomentumObserver:
     the trapezoidal rule, r implicit (Tustin). The robot's model is copied at construction.
 
     Parameters: robot, gain (K_O > 0 in 1/s: a number or one per joint), dt (sample period, s).
+    Calls on one observer from several threads run one after the other (run() releases the GIL but
+    keeps the observer to itself); use one observer per thread to run in parallel.
     """
     def __init__(self, robot: Model, gain: float | numpy.typing.ArrayLike, dt: float) -> None: ...
     def reset(self) -> None:
@@ -424,7 +426,8 @@ class RecursiveLeastSquares:
         With lambda < 1, cap on the UD variances against covariance windup when the data stop
         exciting some direction; default the largest initial one (c for a number c).
 
-    Not thread-safe: use one estimator per thread.
+    Calls on one estimator from several threads run one after the other (a batch update releases
+    the GIL but keeps the estimator to itself); use one estimator per thread to run in parallel.
     """
     def __copy__(self) -> RecursiveLeastSquares: ...
     def __deepcopy__(self, memo: dict[int, typing.Any]) -> RecursiveLeastSquares: ...
