@@ -133,6 +133,19 @@ def test_errors_exit_2_with_one_line(files, capsys, argv, message):
     assert message in err and "Traceback" not in err
 
 
+@pytest.mark.parametrize("command", ["identify", "validate", "residual"])
+def test_an_unknown_option_is_reported_with_the_commands_usage(files, capsys, command):
+    """Issue 22: `dynid identify LOG --frobnicate` printed the top-level usage."""
+    positionals = {"identify": ["{d}/train.npz"], "validate": ["{d}/r", "{d}/check.csv"]}
+    argv = [command, *positionals.get(command, ["{d}/r", "{d}/check.csv"]), "--frobnicate"]
+    with pytest.raises(SystemExit) as exit_status:
+        main([a.format(d=files) for a in argv])
+    assert exit_status.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"usage: dynid {command} "), err
+    assert err.endswith(f"dynid {command}: error: unrecognized arguments: --frobnicate\n"), err
+
+
 def test_as_a_process(files):
     """The installed entry point: a bad input is one line on stderr and exit status 2."""
     done = subprocess.run(

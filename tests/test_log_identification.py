@@ -229,6 +229,21 @@ def test_summary_lists_every_coefficient(lwr_result):
     assert "J7" in text  # the per-joint fit table
 
 
+def test_summary_shows_a_dash_where_there_is_no_standard_deviation(lwr_result):
+    """A physical fit has no standard deviations (std = inf): issue 22 found "inf inf%" printed
+    for every coefficient. The values themselves are printed as before."""
+    import copy
+
+    physical = copy.copy(lwr_result)
+    physical.std = np.full(lwr_result.theta.size, np.inf)
+    physical.relative_std = np.full(lwr_result.theta.size, np.inf)
+    text = physical.summary()
+    assert "inf" not in text
+    for name, value in zip(lwr_result.names, lwr_result.theta):
+        row = next(line for line in text.splitlines() if line.startswith(f"  {name} "))
+        assert row.split()[1:4] == [f"{value:.5g}", "-", "-"], row
+
+
 def test_excluded_joint_rows_are_left_out(lwr):
     """Joint 1's rows are the only ones holding Iyy1R (joint 1's inertia about its axis)."""
     with pytest.raises(RankDeficientError, match="Iyy1R"):

@@ -13,6 +13,7 @@ Tolerances: 1e-12 relative (exact maths, double rounding); 1e-10 relative in
 from __future__ import annotations
 
 import csv
+import re
 from importlib.resources import files
 
 import numpy as np
@@ -132,3 +133,20 @@ def test_the_installed_package_ships_its_data() -> None:
     # wheel.packages = ["python/dynid"] ships every file of the folder, not only .py ones
     for name in ("franka_panda_gaz2019.csv", "ur5.urdf", "ur10.urdf", "README.md"):
         assert files("dynid").joinpath("data", name).is_file(), name
+
+
+def test_info_prints_rounding_residue_as_zero_and_keeps_real_small_values():
+    """`dynid info` on the UR5 read from its URDF printed alpha = -6.12323e-17 (-3.508e-15°) and a
+    product of inertia of 1.704e-100 (issue 22). Residue below 1e-9 of its scale reads 0 (never
+    -0); a value that is small but real (a light link's inertia) is printed as it is."""
+    from dynid.summary import model_summary
+
+    robot = dynid.models.ur5()
+    assert np.abs(robot.dh[:, 1] % (np.pi / 2)).min() < 1e-15  # the residue is there...
+    text = model_summary(robot)
+    assert not re.search(r"e-(1[0-9]|[2-9][0-9]|1[0-9][0-9])\b", text), text  # ...not shown
+    assert "-0 " not in text and "-0.0," not in text
+    light = dynid.models.planar_2r()
+    light.set_link(1, mass=1e-3, com=[1e-4, 0, 0], inertia_com=np.diag([1e-9, 2e-9, 3e-9]))
+    row = next(line for line in model_summary(light).splitlines() if "link 2:" in line)
+    assert "0.001" in row and "1e-07" in row, row  # mx = m * 1e-4

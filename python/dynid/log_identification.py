@@ -275,7 +275,9 @@ class LogIdentification(ValueEquality):
         for name, value, std, rel, expr in zip(
             self.names, self.theta, self.std, self.relative_std, self.expressions
         ):
-            lines.append(f"  {name:<{width}}  {value:>12.5g}  {std:>10.3g}  {rel:>7.3g}%  {expr}")
+            # No standard deviation (a physical fit: inf) is a dash, not "inf inf%".
+            spread = f"{std:>10.3g}  {rel:>7.3g}%" if np.isfinite(std) else f"{'-':>10}  {'-':>8}"
+            lines.append(f"  {name:<{width}}  {value:>12.5g}  {spread}  {expr}")
         text = "\n".join(head + lines)
         metrics = self.training.get("metrics")
         if metrics:

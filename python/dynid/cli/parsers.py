@@ -30,6 +30,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_info(subcommands)
     _add_export(subcommands)
     _add_residual(subcommands)
+    # Each command knows its own parser, so that an option it does not have is reported with the
+    # command's usage, not the top level's (main()).
+    for command in subcommands.choices.values():
+        command.set_defaults(command_parser=command)
     return parser
 
 
