@@ -279,6 +279,27 @@ def test_residual_files_and_plot(tmp_path, contact_run):
         residual_from_log("robot", log, 50.0)
 
 
+@pytest.mark.parametrize("scale", [2.0**700, 2.0**-700])
+def test_residual_rms_of_huge_and_tiny_torques_is_finite_and_exact(contact_run, scale):
+    """Issue 22: rms = sqrt(mean(r**2)) was inf for |r| beyond ~1e154 (and 0 below ~1e-162).
+    A robot and torques scaled by a power of two give a residual scaled by it exactly, and its
+    RMS must be the unscaled RMS times that power."""
+    from dynid.io import Log
+    from dynid.observer import residual_from_log
+
+    robot, t, q, qd, tau, _ = contact_run
+    plain = residual_from_log(robot, Log(t=t, q=q, qd=qd, tau=tau), 50.0)
+    heavy = robot.copy()  # every dynamic parameter times the scale: the residual scales too
+    heavy.params = robot.params * scale
+    heavy.Ia, heavy.Fv, heavy.Fs = robot.Ia * scale, robot.Fv * scale, robot.Fs * scale
+    scaled = residual_from_log(heavy, Log(t=t, q=q, qd=qd, tau=tau * scale), 50.0)
+    np.testing.assert_allclose(
+        scaled.r / scale, plain.r, rtol=1e-12, atol=1e-12 * plain.max_abs.max()
+    )
+    assert np.all(np.isfinite(scaled.rms)) and np.all(scaled.rms > 0)
+    np.testing.assert_allclose(scaled.rms / scale, plain.rms, rtol=1e-12)
+
+
 # ----------------------------------------------------------------------------- real time
 
 

@@ -274,6 +274,7 @@ def test_bad_noise_levels_raise_value_error_naming_them(name, value):
         ({"encoder_counts": np.nan}, "encoder_counts"),
         ({"encoder_counts": "many"}, "encoder_counts"),
         ({"encoder_counts": True}, "encoder_counts"),
+        ({"encoder_counts": 1e-300}, "encoder_counts"),  # issue 22: q recorded as 0 throughout
     ],
 )
 def test_bad_sensor_settings_raise_value_error_naming_them(kwargs, name):

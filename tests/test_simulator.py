@@ -407,6 +407,9 @@ def test_too_large_a_step_is_reported_not_returned_as_nan(lwr):
         ({"torque_noise": -0.1}, "torque_noise"),
         ({"torque_noise": np.nan}, "torque_noise"),
         ({"encoder_counts": 0}, "encoder_counts"),
+        # Issue 22: a quantum of 2 pi / 1e-300 rad hid every motion from the controller.
+        ({"encoder_counts": 1e-300}, "encoder_counts"),
+        ({"encoder_counts": 0.5}, "encoder_counts"),
         ({"seed": -1}, "seed"),
         ({"controller": "pd"}, "controller"),
         ({"controller": PD(np.ones(6), 1.0, np.zeros(7))}, "kp"),

@@ -47,8 +47,14 @@ Simulator::Simulator(const Model& plant, const SimulationSettings& settings)
           [&] { return "coulomb_band: expected a finite value >= 0, got " + num(s.coulomb_band); });
   require(std::isfinite(s.torque_noise) && s.torque_noise >= 0.0,
           [&] { return "torque_noise: expected a finite value >= 0, got " + num(s.torque_noise); });
-  require(std::isfinite(s.encoder_counts) && s.encoder_counts >= 0.0,
-          [&] { return "encoder_counts: expected a value >= 0, got " + num(s.encoder_counts); });
+  // Fewer than one count per revolution (per metre) makes a quantum larger than the motion: the
+  // controller would see a constant position and fly blind (issue 22: 1e-300 was accepted).
+  require(std::isfinite(s.encoder_counts) && (s.encoder_counts == 0.0 || s.encoder_counts >= 1.0),
+          [&] {
+            return "encoder_counts: expected 0 (no encoder) or at least 1 count per revolution "
+                   "(per metre), got " +
+                   num(s.encoder_counts);
+          });
   resolution_[0] = s.encoder_counts > 0.0 ? kTwoPi / s.encoder_counts : 0.0;
   resolution_[1] = s.encoder_counts > 0.0 ? 1.0 / s.encoder_counts : 0.0;
   const int n = plant.n();

@@ -22,6 +22,7 @@ from ._checks import real_array
 from .io.log_files import Log
 from .io.preparation import prepare_log
 from .log_identification import LogIdentification
+from .validation import root_mean_square
 
 if TYPE_CHECKING:
     from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
@@ -102,7 +103,7 @@ def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | 
         r=r,
         gain=observer.gain,
         dt=dt,
-        rms=np.sqrt(np.mean(r**2, axis=0)),
+        rms=root_mean_square(r),
         max_abs=np.abs(r).max(axis=0),
     )
 

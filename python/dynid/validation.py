@@ -10,6 +10,14 @@ from numpy.typing import ArrayLike, NDArray
 from ._checks import real_array
 
 
+def root_mean_square(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """sqrt(mean(x**2, axis=0)) without overflow or underflow of the squares: computed on x
+    scaled by the power of two (exact) that brings its largest |value| into [0.5, 1)."""
+    largest = float(np.abs(x).max()) if x.size else 0.0
+    exponent = int(np.frexp(largest)[1]) if 0.0 < largest < np.inf else 0
+    return np.ldexp(np.sqrt(np.mean(np.ldexp(x, -exponent) ** 2, axis=0)), exponent)
+
+
 def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArray[np.float64]]:
     """Per-column (joint) errors of ``predicted`` against ``measured``, both (T, n).
 
@@ -37,12 +45,12 @@ def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArra
     error: NDArray[np.float64] = np.ldexp(predicted, -exponent) - y
     sse = np.sum(error**2, axis=0)
     sst = np.sum((y - y.mean(axis=0)) ** 2, axis=0)
-    rms_measured = np.sqrt(np.mean(y**2, axis=0))
+    rms_measured = root_mean_square(y)
     with np.errstate(divide="ignore", invalid="ignore"):
         r2 = np.where(sst > 0.0, 1.0 - sse / sst, np.where(sse == 0.0, 1.0, -np.inf))
         relative = np.where(
             rms_measured > 0.0,
-            np.sqrt(np.mean(error**2, axis=0)) / rms_measured,
+            root_mean_square(error) / rms_measured,
             np.where(sse == 0.0, 0.0, np.inf),
         )
     with np.errstate(over="ignore"):
@@ -55,7 +63,7 @@ def error_metrics(measured: ArrayLike, predicted: ArrayLike) -> dict[str, NDArra
     return {
         "mse": mse,
         "max_abs": np.ldexp(np.max(np.abs(error), axis=0), exponent),
-        "rms": np.ldexp(np.sqrt(np.mean(error**2, axis=0)), exponent),
+        "rms": np.ldexp(root_mean_square(error), exponent),
         "relative_rms": relative,
         "r2": r2,
     }

@@ -36,8 +36,8 @@ struct SimulationSettings {
   // joint and control period (held with the torque).
   double torque_noise = 0.0;
   // Encoder resolution in counts per revolution (revolute joints; counts per metre for prismatic
-  // ones); 0: the controller sees the exact state. With an encoder the controller gets the
-  // quantised position and the backward difference of the quantised positions as velocity.
+  // ones), 0 or >= 1; 0: the controller sees the exact state. With an encoder the controller gets
+  // the quantised position and the backward difference of the quantised positions as velocity.
   double encoder_counts = 0.0;
   std::uint64_t seed = 0;
 };

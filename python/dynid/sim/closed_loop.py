@@ -87,9 +87,9 @@ def simulate(
         Standard deviation [N m] of white noise added to each joint's torque once per control
         period (seeded; the returned ``tau`` is the command before the noise).
     encoder_counts
-        Encoder counts per revolution (per metre for prismatic joints): the controller sees the
-        quantised q and, as velocity, the backward difference of the quantised positions over dt
-        (at t = 0 the known qd0). None: the controller sees the exact state.
+        Encoder counts per revolution (per metre for prismatic joints), at least 1: the controller
+        sees the quantised q and, as velocity, the backward difference of the quantised positions
+        over dt (at t = 0 the known qd0). None: the controller sees the exact state.
     seed
         Seed of the torque noise.
     """

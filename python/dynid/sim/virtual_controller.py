@@ -160,9 +160,14 @@ class VirtualController:
                 f"link_friction: expected a fraction in [0, 1], scalar or shape ({robot.n},), "
                 f"got {link_friction!r}"
             )
-        if encoder_counts is not None and not _positive_number(encoder_counts):
+        # At least one count per revolution, as the simulator requires (cpp/src/simulator.cpp):
+        # a coarser encoder reports a constant position.
+        if encoder_counts is not None and not (
+            _positive_number(encoder_counts) and float(encoder_counts) >= 1.0
+        ):
             raise ValueError(
-                f"encoder_counts: expected a positive count or None, got {encoder_counts!r}"
+                "encoder_counts: expected at least 1 count per revolution (per metre) or None, "
+                f"got {encoder_counts!r}"
             )
         if elastic is not None:
             if not isinstance(elastic, ElasticRobot) or elastic.n != robot.n:
