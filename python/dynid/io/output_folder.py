@@ -1,30 +1,47 @@
-"""Writing a result folder so that results are never lost or mixed (issue: no silent overwrite,
-no half-written file).
+"""Writing a result folder so that results are never lost or mixed (issues 14 and 22).
 
 Everything is written into a fresh temporary folder beside the target; only when every file is
-complete is it moved into place with ``os.replace``. An existing, non-empty target is refused
+complete is dynid's marker ``.dynid-output.json`` (the files written, the dynid version) added
+and the folder moved into place with ``os.replace``. An existing, non-empty target is refused
 unless ``overwrite`` is given, and then it is replaced as a whole (moved aside, the new folder
 moved in, the old one deleted), so a folder never holds files of two runs, and a failure (a full
-disk, a plot that cannot be drawn) leaves the previous folder as it was.
+disk, a plot that cannot be drawn) leaves the previous folder as it was. ``overwrite`` replaces
+only a folder that dynid wrote (it holds the marker), and never one that holds an input of the
+run (the log, the model, the result being validated: the ``inputs``) or the current folder.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import secrets
 import shutil
 import stat
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Union
 
+from .._version import dynid_version
+
 PathLike = Union[str, Path]
 
+#: The file that marks a folder as written by dynid: ``overwrite`` replaces no other folder.
+MARKER = ".dynid-output.json"
+MARKER_FORMAT = "dynid-output"
 
-def check_output_path(folder: PathLike, overwrite: bool, name: str = "output") -> Path:
+
+def check_output_path(
+    folder: PathLike,
+    overwrite: bool,
+    name: str = "output",
+    inputs: Iterable[PathLike | None] = (),
+) -> Path:
     """The output folder as a Path; a ValueError naming ``name`` for an empty path, a path that
-    is a file, or an existing non-empty folder when ``overwrite`` is False."""
+    is a file, a folder that holds the current folder, and an existing non-empty folder unless
+    ``overwrite`` is True and it is a folder dynid wrote that holds none of ``inputs`` (paths of
+    files and folders the run reads; None and what does not exist, e.g. a built-in model's name,
+    are skipped)."""
     if not isinstance(overwrite, bool):
         raise ValueError(f"overwrite: expected True or False, got {overwrite!r}")
     if not isinstance(folder, (str, Path)) or str(folder).strip() == "":
@@ -32,25 +49,51 @@ def check_output_path(folder: PathLike, overwrite: bool, name: str = "output") -
     path = Path(folder)
     if path.exists() and not path.is_dir():
         raise ValueError(f"{name}: {path} exists and is not a folder")
-    if path.is_dir() and any(path.iterdir()) and not overwrite:
+    if not path.is_dir():
+        return path
+    if _holds(path, os.getcwd()):
+        # Replacing it would leave this process, and the shell that started it, in a deleted folder.
+        raise ValueError(
+            f"{name}: {path} is or holds the current folder; choose another (--output)"
+        )
+    if not any(path.iterdir()):
+        return path
+    if not overwrite:
         raise ValueError(
             f"{name}: {path} exists and is not empty; choose another folder or pass "
             "--overwrite (overwrite=True) to replace it"
+        )
+    for item in inputs:
+        if item is not None and _holds(path, item):
+            raise ValueError(
+                f"{name}: {path} holds {item}, an input of this run, which --overwrite would "
+                "delete; choose another folder (--output)"
+            )
+    if not _is_dynid_output(path):
+        raise ValueError(
+            f"{name}: {path} was not written by dynid (it has no {MARKER}); --overwrite "
+            "(overwrite=True) replaces only dynid's result folders: choose another folder "
+            "(--output) or empty this one yourself"
         )
     return path
 
 
 @contextmanager
 def output_folder(
-    folder: PathLike, overwrite: bool = False, name: str = "output"
+    folder: PathLike,
+    overwrite: bool = False,
+    name: str = "output",
+    inputs: Iterable[PathLike | None] = (),
 ) -> Iterator[Path]:
     """Yield a temporary folder to write into; on leaving the block without an error it becomes
-    ``folder`` (see the module docstring); on an error it is removed and ``folder`` is untouched."""
-    target = check_output_path(folder, overwrite, name)
+    ``folder`` (see the module docstring; ``check_output_path`` for ``overwrite`` and
+    ``inputs``); on an error it is removed and ``folder`` is untouched."""
+    target = check_output_path(folder, overwrite, name, inputs)
     target.parent.mkdir(parents=True, exist_ok=True)
     staging = _new_folder(target.parent, f".{target.name}.", ".partial")
     try:
         yield staging
+        _write_marker(staging)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
@@ -61,6 +104,31 @@ def output_folder(
     os.replace(staging, target)
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
+
+
+def _holds(folder: Path, item: PathLike) -> bool:
+    """Whether the existing path ``item`` is ``folder`` or inside it: as written (a symbolic link
+    inside), or with symbolic links resolved (a link to inside)."""
+    if not os.path.lexists(item):
+        return False
+    return any(
+        Path(resolve(item)).is_relative_to(resolve(folder))
+        for resolve in (os.path.abspath, os.path.realpath)
+    )
+
+
+def _is_dynid_output(folder: Path) -> bool:
+    try:
+        marker = json.loads((folder / MARKER).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(marker, dict) and marker.get("format") == MARKER_FORMAT
+
+
+def _write_marker(staging: Path) -> None:
+    files = sorted(p.relative_to(staging).as_posix() for p in staging.rglob("*") if p.is_file())
+    marker = {"format": MARKER_FORMAT, "dynid_version": dynid_version(), "files": files}
+    (staging / MARKER).write_text(json.dumps(marker, indent=1) + "\n", encoding="utf-8")
 
 
 def _new_folder(parent: Path, prefix: str, suffix: str) -> Path:
