@@ -16,6 +16,7 @@ import pytest
 import dynid
 import dynid.cli
 from dynid.demo import LINK_FRICTION, TIP_MASS, controller_model, run_demo
+from dynid.io.output_folder import MARKER
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 PLOTS = ("fig3_joint_motion.png", "fig4_torques.png", "fig6_g2_M11.png")
@@ -154,7 +155,7 @@ def test_demo_never_overwrites_results_silently(tmp_path, capsys):
     assert error.startswith("dynid demo: error: output:") and "--overwrite" in error
     assert (out / "demo.json").read_bytes() == before and (out / "notes.txt").exists()
     assert dynid.cli.main([*argv, "--overwrite"]) == 0
-    assert sorted(p.name for p in out.iterdir()) == sorted(["demo.json", *PLOTS])
+    assert sorted(p.name for p in out.iterdir()) == sorted([MARKER, "demo.json", *PLOTS])
     with pytest.raises(ValueError, match=r"^output:"):
         run_demo(out, train=10, validation=5, progress=lambda _: None)
 

@@ -11,7 +11,7 @@ import pytest
 import dynid
 import dynid.cli
 from dynid import excitation, io, signal
-from dynid.io.output_folder import output_folder, write_text_atomic
+from dynid.io.output_folder import MARKER, output_folder, write_text_atomic
 from dynid.io.result_files import load_result, save_result
 from dynid.log_identification import identify_log
 
@@ -136,7 +136,7 @@ def test_result_folder_is_not_overwritten_silently(small_result, tmp_path) -> No
     assert (out / "result.json").read_text() == before
     save_result(small_result, out, plots=False, overwrite=True)
     # replaced as a whole: no file of the previous run is left beside the new one
-    assert sorted(p.name for p in out.iterdir()) == ["result.json"]
+    assert sorted(p.name for p in out.iterdir()) == sorted([MARKER, "result.json"])
     assert load_result(out).theta.shape == small_result.theta.shape
     with pytest.raises(ValueError, match=r"^output: expected a folder path"):
         save_result(small_result, "", plots=False)

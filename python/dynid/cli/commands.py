@@ -57,7 +57,7 @@ def identify(args: argparse.Namespace) -> None:
     from ..io.result_files import save_result
     from ..log_identification import identify_log
 
-    check_output_path(args.output, args.overwrite)  # before the work, not after
+    check_output_path(args.output, args.overwrite, inputs=identify_inputs(args))  # before the work
     if args.current:
         identify_from_currents(args)
         return
@@ -94,8 +94,14 @@ def identify(args: argparse.Namespace) -> None:
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
     print(result.summary(), flush=True)
-    path = save_result(result, args.output, overwrite=args.overwrite)
+    path = save_result(result, args.output, overwrite=args.overwrite, inputs=identify_inputs(args))
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def identify_inputs(args: argparse.Namespace) -> list[str | None]:
+    """The files ``dynid identify`` reads (options not given are None; built-in model names and
+    payload numbers are no files), which ``--overwrite`` must never delete."""
+    return [args.log, args.model, args.prior, args.payload_log, args.payload]
 
 
 def identify_from_currents(args: argparse.Namespace) -> None:
@@ -144,7 +150,7 @@ def identify_from_currents(args: argparse.Namespace) -> None:
         f"{sum(run['samples'] for run in gains.runs)} samples"
     )
     print(gains.summary(), flush=True)
-    path = save_result(result, args.output, overwrite=args.overwrite)
+    path = save_result(result, args.output, overwrite=args.overwrite, inputs=identify_inputs(args))
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
 
 
@@ -155,7 +161,7 @@ def validate(args: argparse.Namespace) -> None:
     from ..log_identification import run_validation
     from ..validation import validation_table
 
-    check_output_path(args.output, args.overwrite)
+    check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
     step = _steps(3)
     result = load_result(args.result)
     log = load_log(args.log, **log_options(args))
@@ -206,11 +212,12 @@ def residual(args: argparse.Namespace) -> None:
     from ..io.result_files import load_model_or_result
     from ..observer import plot_residual, residual_from_log, save_residual
 
-    check_output_path(args.output, args.overwrite)
+    inputs = [args.model, args.log]
+    check_output_path(args.output, args.overwrite, inputs=inputs)
     model = load_model_or_result(args.model)
     log = load_log(args.log, **log_options(args))
     result = residual_from_log(model, log, args.gain)
-    with output_folder(args.output, args.overwrite) as staging:
+    with output_folder(args.output, args.overwrite, inputs=inputs) as staging:
         save_residual(result, staging / "residual.npz")
         plot_residual(result, staging / "residual.png", threshold=args.threshold)
     print(f"momentum observer, gain {args.gain:g} 1/s, {log.T} samples at dt {result.dt:.4g} s")

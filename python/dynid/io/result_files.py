@@ -16,6 +16,7 @@ result has ("none", "symmetric", "asymmetric"; :mod:`dynid.friction_models`).
 from __future__ import annotations
 
 import json
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, Union
 
@@ -62,13 +63,16 @@ def save_result(
     log: Log | None = None,
     plots: bool = True,
     overwrite: bool = False,
+    inputs: Iterable[PathLike | None] = (),
 ) -> Path:
     """Write ``folder/result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of
     the fit on ``log`` (default: the training log, when the result kept it); returns the JSON
-    path. ``folder`` must be new or empty unless ``overwrite``; it is written as a whole or not
-    at all (:mod:`dynid.io.output_folder`)."""
+    path. ``folder`` must be new or empty unless ``overwrite``, and ``overwrite`` replaces only a
+    folder dynid wrote that holds none of ``inputs`` nor the log's file; it is written as a
+    whole or not at all (:mod:`dynid.io.output_folder`)."""
     log = log if log is not None else result.log
-    with output_folder(folder, overwrite) as staging:
+    inputs = [*inputs, log.source if log is not None else None]
+    with output_folder(folder, overwrite, inputs=inputs) as staging:
         (staging / RESULT_FILE).write_text(dumps_json(result_to_dict(result)) + "\n")
         if plots and log is not None:
             save_plots(staging, log, result.predict(log), "training log")
@@ -85,7 +89,9 @@ def save_validation(
     overwrite: bool = False,
 ) -> Path:
     """Write ``folder/validation.json`` (per-joint metrics, preparation, sources) and, when
-    ``plots``, the torque and residual plots of the validation log; returns the JSON path."""
+    ``plots``, the torque and residual plots of the validation log; returns the JSON path.
+    ``overwrite`` never replaces a folder that holds ``result_source`` or the log's file
+    (:mod:`dynid.io.output_folder`)."""
     report = {
         "format": VALIDATION_FORMAT,
         "version": VALIDATION_VERSION,
@@ -97,7 +103,8 @@ def save_validation(
         "notes": validation.log.notes,
         "metrics": metrics_to_dict(validation.metrics),
     }
-    with output_folder(folder, overwrite) as staging:
+    inputs = [result_source, log_source, validation.log.source]
+    with output_folder(folder, overwrite, inputs=inputs) as staging:
         (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
         if plots:
             save_plots(staging, validation.log, validation.predicted, "validation log")
