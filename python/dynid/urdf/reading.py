@@ -87,13 +87,13 @@ def _link_parameters(
     tree: UrdfTree, joints: list[Joint], poses: dict[str, Array], frames: list[Array]
 ) -> Array:
     """(n, 10): the inertials of body i (see the module docstring) in DH frame i, summed."""
-    bodies = _bodies(tree, joints)
+    members: list[list[str]] = [[] for _ in joints]
+    for link, body in _bodies(tree, joints).items():
+        members[body].append(link)
     params = np.zeros((len(joints), 10))
     for i, joint in enumerate(joints):
         inertials = [
-            (link, tree.links[link])
-            for link, body in bodies.items()
-            if body == i and tree.links[link] is not None
+            (link, tree.links[link]) for link in members[i] if tree.links[link] is not None
         ]
         if not inertials:
             raise ValueError(
