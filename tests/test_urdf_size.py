@@ -7,6 +7,7 @@ ratio of 2; 4 when every link scans every joint, as the reader did)."""
 
 from __future__ import annotations
 
+import json
 import sys
 from collections.abc import Callable
 from functools import partial
@@ -15,9 +16,13 @@ from types import FrameType
 from typing import Any
 
 import numpy as np
+import pytest
 
 import dynid
+import dynid.cli
 import dynid.urdf
+from dynid._checks import MAX_JOINTS
+from dynid.io.model_files import load_model
 
 INERTIAL = (
     '<inertial><mass value="1"/>'
@@ -30,9 +35,10 @@ def long_chain(links: int, movable: int) -> str:
     between them (evenly spaced, the last one on the last link) are revolute about y, the others
     fixed."""
     every = (links - 1) // movable
+    revolute = {links - 1 - k * every for k in range(movable)}
     parts = [f'<link name="l{i}">{INERTIAL}</link>' for i in range(links)]
     for i in range(1, links):
-        kind = "revolute" if (links - 1 - i) % every == 0 and i >= every else "fixed"
+        kind = "revolute" if i in revolute else "fixed"
         parts.append(
             f'<joint name="j{i}" type="{kind}"><parent link="l{i - 1}"/><child link="l{i}"/>'
             '<origin xyz="0 0 0.001"/><axis xyz="0 1 0"/></joint>'
@@ -86,3 +92,36 @@ def test_reading_is_linear_in_the_number_of_links() -> None:
         read = partial(dynid.Robot.from_urdf, long_chain(links, 6))
         counts[links] = lines_executed(read, 1000 * links)
     assert counts[10_000] < 2.5 * counts[5_000], counts
+
+
+def test_a_chain_of_more_joints_than_a_model_file_holds_is_refused(tmp_path: Path) -> None:
+    """The 64-joint cap of model files (MAX_JOINTS, one constant) applies to the URDF chain: 300
+    joints (the issue's URDF, on which `dynid info` ran 755 s) are refused while reading, naming
+    the tip link and the count, in fewer lines than reading 64 joints costs."""
+    text = long_chain(301, 300)
+    with pytest.raises(ValueError, match=r"tip_link 'l300' has 300 movable joints.*at most 64"):
+        dynid.Robot.from_urdf(text)
+
+    def refuse() -> None:
+        with pytest.raises(ValueError, match="at most 64"):
+            dynid.Robot.from_urdf(text)
+
+    refusal = lines_executed(refuse, 1000 * 301)
+    reading = lines_executed(partial(dynid.Robot.from_urdf, long_chain(301, MAX_JOINTS)), 10**6)
+    assert refusal < reading
+    # the cap is the model files': MAX_JOINTS joints are read, one more is refused, either way
+    assert dynid.Robot.from_urdf(long_chain(MAX_JOINTS + 1, MAX_JOINTS)).n == MAX_JOINTS
+    with pytest.raises(ValueError, match=f"{MAX_JOINTS + 1} movable joints"):
+        dynid.Robot.from_urdf(long_chain(MAX_JOINTS + 2, MAX_JOINTS + 1))
+    rows = {"convention": "standard", "rows": [[0.1, 0.0, 0.0, 0.0]] * (MAX_JOINTS + 1)}
+    (tmp_path / "model.json").write_text(json.dumps(rows))
+    with pytest.raises(ValueError, match=f"at most {MAX_JOINTS} joints"):
+        load_model(tmp_path / "model.json")
+
+
+def test_the_command_line_refuses_the_issues_urdf(tmp_path: Path, capsys) -> None:
+    path = tmp_path / "arm300.urdf"
+    path.write_text(long_chain(301, 300))
+    assert dynid.cli.main(["info", "--model", str(path)]) == 2
+    error = capsys.readouterr().err
+    assert f"{path}: urdf: the chain from 'l0' to tip_link 'l300' has 300 movable joints" in error
