@@ -24,7 +24,8 @@ import numpy as np
 import pytest
 
 import dynid
-from conftest import SEED, make_arm, random_state
+from conftest import SEED, make_arm, random_pose, random_state
+from dynid.base_parameters import CACHE_SIZE
 
 RTOL = 1e-9
 FRESH_SEED = SEED + 1000  # the library draws its samples from seed 0 with its own sampler
@@ -249,6 +250,34 @@ def test_deterministic_and_cached() -> None:
     assert dynid.base_parameters(first) is not dynid.base_parameters(first, rotor=True)
     with pytest.raises(dataclasses.FrozenInstanceError):
         dynid.base_parameters(first).count = 0
+
+
+def test_cache_keeps_the_most_recently_used_and_stays_correct() -> None:
+    """A sweep over gravity directions, base poses and transmissions (a mobile base, a
+    calibration) keeps at most CACHE_SIZE results on the robot, the least recently used dropped
+    first; every result equals that of a fresh copy (no cache) of the robot as it is then."""
+    rng = np.random.default_rng(SEED)
+    robot = dynid.models.planar_2r()
+    kept = dynid.base_parameters(robot)  # used at every step below: never dropped
+    vertical = robot.gravity_vector.copy()
+    options = {"rotor": True, "friction": True}
+    cache = robot.__dict__["_base_parameter_cache"]
+    for step, angle in enumerate(np.linspace(0.0, np.pi / 2, 3 * CACHE_SIZE)):
+        robot.gravity_vector = 9.81 * np.array([np.sin(angle), 0.0, -np.cos(angle)])
+        robot.base = random_pose(rng)
+        robot.transmission = [[1.0, 0.0], [step / 10, 1.0]]
+        for rotor_friction in (False, True):
+            got = dynid.base_parameters(robot, **(options if rotor_friction else {}))
+            fresh = dynid.base_parameters(robot.copy(), **(options if rotor_friction else {}))
+            np.testing.assert_array_equal(got.beta, fresh.beta)
+            np.testing.assert_array_equal(got.independent, fresh.independent)
+        assert len(cache) <= CACHE_SIZE
+        saved = robot.copy()
+        robot.gravity_vector, robot.base, robot.transmission = vertical, np.eye(4), None
+        assert dynid.base_parameters(robot) is kept
+        robot.gravity_vector, robot.base = saved.gravity_vector, saved.base
+        robot.transmission = saved.transmission
+    assert len(cache) == CACHE_SIZE
 
 
 # ---- counts -------------------------------------------------------------------------------------

@@ -19,6 +19,7 @@ import pytest
 
 import dynid
 from dynid.urdf.reading import standard_parameters
+from dynid.urdf.tree import read_tree
 from pinocchio_urdf import (
     DATA,
     assert_matches_pinocchio,
@@ -83,6 +84,41 @@ def test_real_arm_matches_pinocchio(case: str, convention: str) -> None:
             np.testing.assert_array_equal(robot.qlim[i], limits)
         else:  # continuous: one turn
             np.testing.assert_array_equal(robot.qlim[i], [-np.pi, np.pi])
+
+
+# every real URDF of these tests, and example-robot-data's copies of the UR and Panda arms
+REAL_FILES = sorted(
+    {str(path) for path, _, _ in REAL.values()}
+    | {
+        "panda_description/urdf/panda.urdf",
+        "ur_description/urdf/ur5_robot.urdf",
+        "ur_description/urdf/ur10_robot.urdf",
+        "ur_description/urdf/ur3_robot.urdf",
+    }
+)
+
+
+@pytest.mark.parametrize("path", REAL_FILES)
+def test_real_urdfs_pass_the_physical_check_on_every_chain(path: str) -> None:
+    """The physical check (on by default) refuses nothing legitimate: every chain from the root
+    to a leaf of a real arm's URDF reads, massless frames (world, base, tool0, flange, tcp) merged
+    away; what it reads is consistent and to_urdf writes it (one rule on both sides). The leaves
+    that are no chain are refused for what they are: fixed to the root, or behind a mimic
+    finger joint."""
+    text = _text(Path(path) if path.startswith("/") else path)
+    tree = read_tree(text)
+    chains, refused = 0, {}
+    for leaf in (link for link in tree.links if not tree.children(link)):
+        try:
+            robot = dynid.Robot.from_urdf(text, tip_link=leaf)
+        except ValueError as exc:
+            refused[leaf] = str(exc)
+            continue
+        assert robot.is_physically_consistent(), leaf
+        assert robot.to_urdf()
+        chains += 1
+    assert chains >= 1
+    assert all("no movable joint" in why or "mimic" in why for why in refused.values()), refused
 
 
 def test_path_and_text_give_the_same_robot() -> None:

@@ -67,8 +67,9 @@ def test_mimic_joint_on_the_chain_is_named() -> None:
 
 def test_missing_inertial_names_the_link() -> None:
     text = chain(*SERIAL).replace(f'<link name="l2">{INERTIAL}</link>', '<link name="l2"/>')
-    with pytest.raises(ValueError, match=r"link 'l2'.*joint 'j2'.*inertial"):
+    with pytest.raises(ValueError, match=r"link 'l2'.*joint 'j2'.*inertial.*check_physical"):
         dynid.Robot.from_urdf(text)
+    assert not dynid.Robot.from_urdf(text, check_physical=False).params[1].any()  # to repair
     # massless frames fixed to a moving link are fine (tool0, ee_link of industrial URDFs)
     text = chain(
         *SERIAL,
@@ -162,3 +163,95 @@ def test_base_link_and_tip_link_select_the_chain() -> None:
     assert sub.n == 3
     np.testing.assert_array_equal(sub.qlim, full.qlim[2:5])
     np.testing.assert_array_equal(sub.Fv, full.Fv[2:5])
+
+
+def inertial(mass: str = "1", ixx: str = "0.1", iyy: str = "0.1", izz: str = "0.1") -> str:
+    return (
+        f'<inertial><mass value="{mass}"/>'
+        f'<inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>'
+    )
+
+
+MASSLESS = inertial(mass="0", ixx="0", iyy="0", izz="0")
+
+
+def with_link2(body: str, pad: str | None = None, extra: str = "") -> str:
+    """The serial chain with link l2's inertial replaced by ``body`` and ``extra`` inside joint
+    j2; with ``pad`` (an inertial, or ""), a link 'pad' is fixed between l2 and joint j3."""
+    j3 = joint("j3", "l2" if pad is None else "pad", "l3")
+    fixed = '<joint name="f" type="fixed"><parent link="l2"/><child link="pad"/></joint>'
+    text = chain(
+        joint("j1", "l0", "l1"),
+        joint("j2", "l1", "l2", extra=extra),
+        *([j3] if pad is None else [fixed, j3]),
+        links="" if pad is None else f'<link name="pad">{pad}</link>',
+    )
+    return text.replace(f'<link name="l2">{INERTIAL}</link>', f'<link name="l2">{body}</link>')
+
+
+@pytest.mark.parametrize(
+    ("body", "pad", "reason"),
+    [
+        (inertial(mass="-1"), None, "mass -1.0 is not positive"),
+        (MASSLESS, None, "mass 0.0 is not positive"),  # a frame between two joints: no body
+        (inertial(ixx="-0.1"), None, "inertia about the centre of mass must be positive definite"),
+        (inertial(izz="0.3"), None, "principal moments of inertia violate the triangle inequality"),
+        (INERTIAL, inertial(mass="-2"), "mass -1.0 is not positive"),  # 1 kg - 2 kg
+        (MASSLESS, inertial(mass="0.5", izz="0.3"), "principal moments"),  # pad's, merged
+    ],
+)
+def test_a_body_that_to_urdf_refuses_is_refused_by_name(
+    body: str, pad: str | None, reason: str
+) -> None:
+    """One rule (dynid.urdf.consistency) on both sides: the body from_urdf refuses (naming its
+    link and joint, and the links merged into it) is the link to_urdf refuses, for the same
+    reason; check_physical=False reads the file as it is."""
+    text = with_link2(body, pad)
+    merged = "" if pad is None else "; merged with 'pad'"
+    with pytest.raises(
+        ValueError,
+        match=rf"^link 'l2' \(moved by joint 'j2'{merged}\) is not physically consistent "
+        rf"\({reason}.*check_physical=False",
+    ):
+        dynid.Robot.from_urdf(text)
+    robot = dynid.Robot.from_urdf(text, check_physical=False)
+    assert robot.n == 3 and robot._link_inconsistency(1)  # link 2 as in the file
+    assert not robot._link_inconsistency(0) and not robot._link_inconsistency(2)
+    with pytest.raises(
+        ValueError, match=rf"^robot: link 2 is not physically consistent \({reason}"
+    ):
+        robot.to_urdf()
+
+
+@pytest.mark.parametrize(
+    ("extra", "reason", "field", "value"),
+    [
+        ('<dynamics damping="-0.5"/>', r"negative damping \(Fv\) -0.5", "Fv", -0.5),
+        ('<dynamics damping="0.2" friction="-0.1"/>', r"negative friction \(Fs\) -0.1", "Fs", -0.1),
+        ('<!-- dynid: Ia="-0.3" -->', r"negative rotor inertia Ia -0.3", "Ia", -0.3),
+    ],
+)
+def test_a_joint_that_to_urdf_refuses_is_refused_by_name(
+    extra: str, reason: str, field: str, value: float
+) -> None:
+    text = with_link2(INERTIAL, extra=extra)
+    with pytest.raises(ValueError, match=f"^joint 'j2' has {reason};.*check_physical=False"):
+        dynid.Robot.from_urdf(text)
+    robot = dynid.Robot.from_urdf(text, check_physical=False)
+    assert getattr(robot, field)[1] == value
+    with pytest.raises(ValueError, match=f"^robot: joint 2 has {reason};"):
+        robot.to_urdf()
+    setattr(robot, field, np.abs(getattr(robot, field)))  # repaired: written, read back
+    assert getattr(dynid.Robot.from_urdf(robot.to_urdf()), field)[1] == -value
+
+
+def test_massless_frames_merged_into_a_body_are_accepted() -> None:
+    """A link of zero mass and inertia is a frame, not a body: fixed to a link with mass (tool0, a
+    flange) or holding the mass on a link fixed to it, it is merged away; so is a point mass."""
+    reference = dynid.Robot.from_urdf(chain(*SERIAL))
+    for text in (with_link2(INERTIAL, MASSLESS), with_link2(MASSLESS, INERTIAL)):
+        np.testing.assert_array_equal(dynid.Robot.from_urdf(text).params, reference.params)
+    point_mass = dynid.Robot.from_urdf(with_link2(INERTIAL, inertial("0.5", "0", "0", "0")))
+    assert point_mass.params[1, 0] == 1.5 and point_mass.is_physically_consistent()
+    with pytest.raises(ValueError, match="check_physical: expected True or False"):
+        dynid.Robot.from_urdf(chain(*SERIAL), check_physical="no")

@@ -18,6 +18,12 @@ from numpy.typing import ArrayLike, NDArray
 #: dtype kinds accepted as real numbers: signed and unsigned integers, floats.
 REAL_KINDS = "iuf"
 
+#: The most joints a robot read from a file may have: the DH rows of a model file, the movable
+#: joints of a URDF chain (docs/cli.md). Checked before any work on them: a 12 KB model file with
+#: 300 DH rows, or a 100 KB URDF with 300 joints, kept `dynid info` computing base parameters
+#: for many minutes (the URDF's ended in std::bad_alloc).
+MAX_JOINTS = 64
+
 # NumPy < 1.24 warns (and makes an object array) where later versions raise for ragged input.
 _RAGGED_WARNING = getattr(np, "exceptions", np).VisibleDeprecationWarning
 

@@ -13,11 +13,14 @@ for every sample, with beta = [I | T] (rearranged to the standard order).
 
 Base parameters are structural: they depend on the DH table, the joint types and the direction
 of gravity, not on the parameter values nor on the joint limits; the result is cached on the
-robot per kind and per geometry.
+robot per kind and per geometry, the CACHE_SIZE most recently used only (a mobile base or a
+calibration sweep changes the base pose, gravity or transmission without end).
 """
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +45,11 @@ SIGNIFICANT_DIGITS = 12
 NOISE_RATIO = 1e-10
 
 KINDS = ("torque", "gravity", "inertia")
+
+#: Results kept on each robot (least recently used dropped first): the 7 kinds of regressor
+#: (kind, rotor, friction) for one geometry, or a few for two.
+CACHE_SIZE = 8
+_CACHE_LOCK = threading.Lock()  # an OrderedDict's reordering is not atomic (robots are shared)
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,10 +104,19 @@ def base_parameters(
         robot.base.tobytes(),
         robot.transmission.tobytes(),  # couples the drive columns (docs/transmission.md)
     )
-    cache = robot.__dict__.setdefault("_base_parameter_cache", {})
-    if key not in cache:
-        cache[key] = _compute(robot, kind, bool(rotor), bool(friction))
-    return cache[key]
+    with _CACHE_LOCK:
+        cache = robot.__dict__.setdefault("_base_parameter_cache", OrderedDict())
+        found = cache.get(key)
+        if found is not None:
+            cache.move_to_end(key)
+            return found
+    found = _compute(robot, kind, bool(rotor), bool(friction))  # outside the lock: may take long
+    with _CACHE_LOCK:
+        cache[key] = found
+        cache.move_to_end(key)  # another thread may have stored it meanwhile
+        while len(cache) > CACHE_SIZE:
+            cache.popitem(last=False)
+    return found
 
 
 def stacked_regressor(

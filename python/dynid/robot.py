@@ -116,6 +116,7 @@ class Robot(_core.Model):
         tip_link: str | None = None,
         convention: str = "standard",
         gravity: ArrayLike = (0.0, 0.0, -9.81),
+        check_physical: bool = True,
     ) -> Robot:
         """Build a robot from the serial chain of a URDF (SPEC 6; docs/urdf.md).
 
@@ -129,12 +130,17 @@ class Robot(_core.Model):
         joints: (-pi, pi)), ``<dynamics damping friction>`` to ``Fv`` and ``Fs``.
 
         ValueError (naming the joint, link or argument) for malformed XML, a branched tree
-        without ``tip_link``, floating, planar or mimic joints on the chain, a moving link
-        without any inertial, an axis of zero length.
+        without ``tip_link``, floating, planar or mimic joints on the chain, more than 64 movable
+        joints on it, an axis of zero length; and, unless ``check_physical=False``, for what
+        :meth:`to_urdf` refuses: a moving body (a link with those fixed to it merged: a massless
+        frame link such as ``tool0`` is fine) without m > 0 and an inertia about its centre of
+        mass that is positive definite and satisfies the triangle inequalities, a joint with
+        negative damping, friction or rotor inertia. ``check_physical=False`` reads such a file
+        as it is, to repair it (``set_link``, ``params``, ``Fv``, ``Fs``).
         """
         from .urdf import dh_model_from_urdf  # on first use: import dynid stays fast
 
-        model = dh_model_from_urdf(urdf, base_link, tip_link, convention)
+        model = dh_model_from_urdf(urdf, base_link, tip_link, convention, check_physical)
         robot = cls.from_dh(
             model.dh,
             model.joint_types,
@@ -159,8 +165,9 @@ class Robot(_core.Model):
         z, ``qlim`` as limits, Fv and Fs as ``<dynamics damping friction>``, the base and tool
         transforms as fixed placements, and Ia (no URDF field) as a ``dynid: Ia`` comment that
         :meth:`from_urdf` reads back. ValueError naming the first link that is not physically
-        consistent, or naming ``transmission`` when the drives are coupled (URDF has no place for
-        T; a model file keeps it).
+        consistent or joint with negative Fv, Fs or Ia (the rule :meth:`from_urdf` applies), or
+        naming ``transmission`` when the drives are coupled (URDF has no place for T; a model
+        file keeps it).
         """
         from .urdf import urdf_text, write_urdf  # on first use: import dynid stays fast
 

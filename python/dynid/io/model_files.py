@@ -27,6 +27,7 @@ from typing import Any, Union
 import numpy as np
 
 from .. import models
+from .._checks import MAX_JOINTS
 from ..robot import Robot
 
 PathLike = Union[str, Path]
@@ -71,9 +72,8 @@ ROW_NAMES = {
 }
 YAML_SUFFIXES = (".yaml", ".yml")
 
-#: Limits on what a file may ask for (docs/cli.md), checked before any work: a 12 KB file with
-#: 300 DH rows would otherwise keep `dynid info` computing base parameters for many minutes.
-MAX_JOINTS = 64
+#: Limits on what a file may ask for (docs/cli.md), checked before any work; the number of
+#: joints, MAX_JOINTS, is shared with URDF reading (dynid._checks).
 MAX_FILE_BYTES = 16 * 2**20
 MAX_YAML_ALIASES = 100
 MAX_EXPANDED_VALUES = 1_000_000

@@ -4,7 +4,8 @@ this package; it does not import :mod:`dynid.robot`.
 - :mod:`.tree`: the XML read into links and joints, the serial chain between two links;
 - :mod:`.frames`: DH frames along arbitrary joint axes (standard or modified);
 - :mod:`.reading`: the chain as a DH model (table, base, tool, parameters, limits, friction);
-- :mod:`.writing`: a DH model written as URDF text.
+- :mod:`.writing`: a DH model written as URDF text;
+- :mod:`.consistency`: the physical rule both apply (``to_urdf`` and ``from_urdf`` refuse alike).
 """
 
 from .reading import DHModel, dh_model_from_urdf

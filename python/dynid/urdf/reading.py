@@ -5,6 +5,10 @@ the links reached from it through fixed joints, and also through joints off the 
 are held at position 0 (the fingers of a gripper, say; Pinocchio's ``buildReducedModel`` with
 the zero configuration does the same). Links that do not move with any chain joint (the base
 and what is fixed to it, links above ``base_link``) belong to the world and are left out.
+
+The bodies so merged and the chain's joints must obey the rule ``to_urdf`` applies
+(:mod:`.consistency`), unless ``check_physical=False``: a massless frame link merged into a body
+with mass is no body of its own.
 """
 
 from __future__ import annotations
@@ -17,6 +21,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks as checks
+from .consistency import BODY_RULE, JOINT_RULE, body_inconsistency, joint_inconsistency
 from .frames import PARALLEL, dh_frames, dh_modified, dh_standard, nearly_parallel
 from .tree import MOVABLE, Joint, UrdfTree, read_tree, serial_chain
 
@@ -50,11 +56,13 @@ def dh_model_from_urdf(
     base_link: str | None = None,
     tip_link: str | None = None,
     convention: str = "standard",
+    check_physical: bool = True,
 ) -> DHModel:
     """Read ``urdf`` (a path or the XML text) into a DH model (see
     :meth:`dynid.Robot.from_urdf`)."""
     if convention not in ("standard", "modified"):
         raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
+    check_physical = checks.flag(check_physical, "check_physical")
     tree = read_tree(urdf)
     chain = serial_chain(tree, base_link, tip_link)
     poses = _poses_at_zero(tree, chain[0].parent)  # links below base_link, in its coordinates
@@ -66,14 +74,15 @@ def dh_model_from_urdf(
     tip = poses[chain[-1].child]
     dh, base_pose = dh_frames(points, axes, tip, convention)
     frames = _dh_frames_at_zero(dh, base_pose, convention)
-    return DHModel(
+    bodies = _bodies(tree, joints)
+    model = DHModel(
         name=tree.name,
         dh=dh,
         joint_types="".join("P" if j.type == "prismatic" else "R" for j in joints),
         convention=convention,
         base=base_pose,
         tool=np.linalg.inv(frames[-1]) @ tip,
-        params=_link_parameters(tree, joints, poses, frames[1:]),
+        params=_link_parameters(tree, bodies, poses, frames[1:]),
         qlim=np.array([_limits(j) for j in joints]),
         Ia=np.array([j.rotor_inertia for j in joints]),
         Fv=np.array([j.damping for j in joints]),
@@ -81,32 +90,51 @@ def dh_model_from_urdf(
         joint_names=[j.name for j in joints],
         link_names=[j.child for j in joints],
     )
+    if check_physical:
+        _check_physical(tree, joints, bodies, model)
+    return model
 
 
 def _link_parameters(
-    tree: UrdfTree, joints: list[Joint], poses: dict[str, Array], frames: list[Array]
+    tree: UrdfTree, bodies: list[list[str]], poses: dict[str, Array], frames: list[Array]
 ) -> Array:
-    """(n, 10): the inertials of body i (see the module docstring) in DH frame i, summed."""
-    bodies = _bodies(tree, joints)
-    params = np.zeros((len(joints), 10))
-    for i, joint in enumerate(joints):
-        inertials = [
-            (link, tree.links[link])
-            for link, body in bodies.items()
-            if body == i and tree.links[link] is not None
-        ]
-        if not inertials:
-            raise ValueError(
-                f"link {joint.child!r} (moved by joint {joint.name!r}) has no "
-                "<inertial>, nor has any link fixed to it"
-            )
+    """(n, 10): the inertials of body i (see the module docstring) in DH frame i, summed (zero
+    for a body without any)."""
+    params = np.zeros((len(bodies), 10))
+    for i, links in enumerate(bodies):
         to_frame = np.linalg.inv(frames[i])
-        for link, inertial in inertials:
-            assert inertial is not None  # links without <inertial> were left out above
-            params[i] += standard_parameters(
-                inertial.mass, to_frame @ poses[link] @ inertial.origin, inertial.inertia
-            )
+        for link in links:
+            inertial = tree.links[link]
+            if inertial is not None:
+                params[i] += standard_parameters(
+                    inertial.mass, to_frame @ poses[link] @ inertial.origin, inertial.inertia
+                )
     return params
+
+
+def _check_physical(
+    tree: UrdfTree, joints: list[Joint], bodies: list[list[str]], model: DHModel
+) -> None:
+    """Refuse what ``to_urdf`` refuses (the rule of :mod:`.consistency`), applied to the bodies
+    as merged: a massless link fixed to one with mass is no body of its own. Names the link (and
+    those merged into it) or the joint."""
+    repair = "Robot.from_urdf(..., check_physical=False) reads it anyway (to repair it)"
+    for i, joint in enumerate(joints):
+        with_inertial = [link for link in bodies[i] if tree.links[link] is not None]
+        merged = [link for link in with_inertial if link != joint.child]
+        body = f"link {joint.child!r} (moved by joint {joint.name!r}"
+        if merged:
+            more = ", ..." if len(merged) > 5 else ""
+            body += f"; merged with {', '.join(repr(link) for link in merged[:5])}{more}"
+        body += ")"
+        if not with_inertial:
+            raise ValueError(f"{body} has no <inertial>, nor has any link fixed to it; {repair}")
+        why = body_inconsistency(model.params[i])
+        if why:
+            raise ValueError(f"{body} is not physically consistent ({why}); {BODY_RULE}; {repair}")
+        why = joint_inconsistency(model.Ia[i], model.Fv[i], model.Fs[i])
+        if why:
+            raise ValueError(f"joint {joint.name!r} has {why}; {JOINT_RULE}; {repair}")
 
 
 def _warn_nearly_parallel(joints: list[Joint], axes: Array) -> None:
@@ -155,14 +183,15 @@ def _poses_at_zero(tree: UrdfTree, base: str) -> dict[str, Array]:
     return poses
 
 
-def _bodies(tree: UrdfTree, joints: list[Joint]) -> dict[str, int]:
-    """Link -> index of the chain joint that moves it (0-based); links of the world left out."""
+def _bodies(tree: UrdfTree, joints: list[Joint]) -> list[list[str]]:
+    """The links of body i (moved by chain joint i, 0-based), joint i's child first; links of the
+    world left out."""
     index = {joint.child: i for i, joint in enumerate(joints)}
-    bodies: dict[str, int] = {}
+    bodies: list[list[str]] = [[] for _ in joints]
     stack = [(joint.child, i) for i, joint in enumerate(joints)]
     while stack:
         link, body = stack.pop()
-        bodies[link] = body
+        bodies[body].append(link)
         for joint in tree.children(link):
             if joint.child not in index:  # not the next chain joint's child
                 stack.append((joint.child, body))

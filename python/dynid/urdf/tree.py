@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import MAX_JOINTS
+
 if TYPE_CHECKING:
     from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
 
@@ -56,13 +58,21 @@ class UrdfTree:
     links: dict[str, Inertial | None]
     joints: dict[str, Joint]  # by child link name
     joint_names: set[str] = field(default_factory=set)
+    # parent link -> its joints, in file order: indexed once, so that walking the tree is linear
+    # in its size (scanning every joint for each link made a 100k-link file take ~20 minutes)
+    _children: dict[str, list[Joint]] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._children = {}
+        for joint in self.joints.values():
+            self._children.setdefault(joint.parent, []).append(joint)
 
     @property
     def root(self) -> str:
         return next(name for name in self.links if name not in self.joints)
 
     def children(self, link: str) -> list[Joint]:
-        return [joint for joint in self.joints.values() if joint.parent == link]
+        return self._children.get(link, [])
 
 
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> Array:
@@ -137,7 +147,7 @@ def read_tree(urdf: str | Path) -> UrdfTree:
 
 def serial_chain(tree: UrdfTree, base_link: str | None, tip_link: str | None) -> list[Joint]:
     """The joints from ``base_link`` (default: the root) down to ``tip_link`` (default: the single
-    leaf below a movable joint), fixed ones included, in order."""
+    leaf below a movable joint), fixed ones included, in order; at most MAX_JOINTS movable."""
     base = tree.root if base_link is None else _link_name(tree, base_link, "base_link")
     if tip_link is None:
         leaves = _moving_leaves(tree, base)
@@ -171,8 +181,14 @@ def serial_chain(tree: UrdfTree, base_link: str | None, tip_link: str | None) ->
                 f"joint {joint.name!r}: a mimic joint (coupled to another) cannot be "
                 "an independent DH joint"
             )
-    if not any(joint.type in MOVABLE for joint in chain):
+    movable = sum(joint.type in MOVABLE for joint in chain)
+    if not movable:
         raise ValueError(f"urdf: no movable joint between {base!r} and {tip!r}")
+    if movable > MAX_JOINTS:
+        raise ValueError(
+            f"urdf: the chain from {base!r} to tip_link {tip!r} has {movable} movable joints; "
+            f"a robot read from a file (URDF or model file) has at most {MAX_JOINTS}"
+        )
     return chain
 
 

@@ -34,7 +34,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import _core
+from .consistency import (
+    BODY_RULE,
+    JOINT_RULE,
+    body_inconsistency,
+    joint_inconsistency,
+    physical_form,
+)
 
 if TYPE_CHECKING:
     from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
@@ -44,10 +50,12 @@ Array: TypeAlias = NDArray[np.float64]
 
 def urdf_text(robot: Any, name: str = "robot") -> str:
     """The URDF of ``robot`` (a :class:`dynid.Robot`) as text. ValueError naming the first link
-    that is not physically consistent (URDF consumers need m > 0 and a positive definite inertia
-    that satisfies the triangle inequalities). ValueError naming ``transmission`` for a robot
-    with coupled drives: URDF's per-joint ``<dynamics>`` cannot hold per-motor friction mapped
-    through T (docs/transmission.md; a model file keeps it)."""
+    or joint that breaks the rule of :mod:`.consistency` (URDF consumers need m > 0, a positive
+    definite inertia that satisfies the triangle inequalities, and damping, friction and rotor
+    inertia >= 0), the rule that :meth:`dynid.Robot.from_urdf` applies to what it reads.
+    ValueError naming ``transmission`` for a robot with coupled drives: URDF's per-joint
+    ``<dynamics>`` cannot hold per-motor friction mapped through T (docs/transmission.md; a
+    model file keeps it)."""
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: expected a non-empty robot name, got {name!r}")
     if robot.coupled:
@@ -57,7 +65,16 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
             "dynid.save_model (a model file keeps the transmission), or write "
             "robot.rigid_body()"
         )
-    links = [_physical(robot.params[i], i) for i in range(robot.n)]
+    for i in range(robot.n):
+        why = body_inconsistency(robot.params[i])
+        if why:
+            raise ValueError(
+                f"robot: link {i + 1} is not physically consistent ({why}); {BODY_RULE}"
+            )
+        why = joint_inconsistency(robot.Ia[i], robot.Fv[i], robot.Fs[i])
+        if why:
+            raise ValueError(f"robot: joint {i + 1} has {why}; in a URDF {JOINT_RULE}")
+    links = [physical_form(robot.params[i]) for i in range(robot.n)]
     dh = np.asarray(robot.dh, dtype=float)
     standard = robot.convention == "standard"
     root = ET.Element("robot", name=name)
@@ -171,31 +188,6 @@ def rpy(rotation: Array) -> Array:
             np.arctan2(rotation[1, 0], rotation[0, 0]),
         ]
     )
-
-
-def _physical(params: Array, i: int) -> tuple[float, Array, Array]:
-    mass = float(params[0])
-    com = np.asarray(params[1:4]) / mass if mass > 0.0 else np.zeros(3)
-    about_origin = np.array(
-        [
-            [params[4], params[5], params[6]],
-            [params[5], params[7], params[8]],
-            [params[6], params[8], params[9]],
-        ]
-    )
-    inertia = about_origin - mass * ((com @ com) * np.eye(3) - np.outer(com, com))
-    why = (
-        f"mass {mass} is not positive"
-        if not mass > 0.0
-        else _core.physical_inconsistency(mass, inertia)
-    )
-    if why:
-        raise ValueError(
-            f"robot: link {i + 1} is not physically consistent ({why}); a URDF link "
-            "needs m > 0 and a positive definite inertia about its centre of mass "
-            "that satisfies the triangle inequalities"
-        )
-    return mass, com, inertia
 
 
 def _dh_offset(a: float, alpha: float, d: float, theta: float, standard: bool) -> Array:
