@@ -132,3 +132,22 @@ def test_path_is_written_atomically_and_never_overwritten(tmp_path: Path) -> Non
     with pytest.raises(ValueError, match="not physically consistent"):  # checked before writing
         bad.to_urdf(path=tmp_path / "bad.urdf")
     assert not (tmp_path / "bad.urdf").exists()
+
+
+@pytest.mark.parametrize("bad", ["arm\x01", "a\x00b", "x\x1b[31m", "\ufffe"])
+def test_a_name_xml_cannot_hold_is_refused(bad: str, tmp_path: Path) -> None:
+    """Issue 22: `to_urdf(name=...)` / `dynid export --name` with a control character wrote a
+    file that is not XML (exit 0). Refused by name, and no file written."""
+    robot = dynid.models.planar_2r()
+    with pytest.raises(ValueError, match=r"^name: expected characters that XML 1\.0 allows"):
+        robot.to_urdf(name=bad, path=tmp_path / "arm.urdf")
+    assert not (tmp_path / "arm.urdf").exists()
+
+
+@pytest.mark.parametrize("name", ['arm & <co> "7"', "bras à 7 axes", "tab\there", "κ-arm"])
+def test_names_xml_can_hold_round_trip(name: str) -> None:
+    """Any name made of XML characters is written escaped and read back exactly."""
+    import xml.etree.ElementTree as ET
+
+    text = dynid.models.planar_2r().to_urdf(name=name)
+    assert ET.fromstring(text).get("name") == name

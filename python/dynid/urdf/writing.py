@@ -26,6 +26,7 @@ parser ignores.
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -48,6 +49,11 @@ if TYPE_CHECKING:
 Array: TypeAlias = NDArray[np.float64]
 
 
+# The characters XML 1.0 does not allow in a document (its Char production): C0 controls other
+# than tab, newline and carriage return, surrogates, U+FFFE and U+FFFF.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
 def urdf_text(robot: Any, name: str = "robot") -> str:
     """The URDF of ``robot`` (a :class:`dynid.Robot`) as text. ValueError naming the first link
     or joint that breaks the rule of :mod:`.consistency` (URDF consumers need m > 0, a positive
@@ -58,6 +64,10 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
     model file keeps it)."""
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: expected a non-empty robot name, got {name!r}")
+    if _NOT_XML.search(name):  # ElementTree writes them as they are: the file would not parse
+        raise ValueError(
+            f"name: expected characters that XML 1.0 allows (no control characters), got {name!r}"
+        )
     if robot.coupled:
         raise ValueError(
             "transmission: a robot with coupled drives (transmission not the identity) cannot be "
