@@ -119,3 +119,32 @@ def test_bad_arguments_name_the_argument() -> None:
         simulate_elastic(elastic, np.zeros(7), controller="pd")
     with pytest.raises(ValueError, match=r"^controller:"):
         simulate_elastic(elastic, np.zeros(7), duration=0.01, controller=lambda *a: np.zeros(3))
+
+
+def test_a_long_run_with_a_cpp_controller_stops_on_keyboard_interrupt() -> None:
+    """Issue 22: simulate_elastic ignored Ctrl-C with its C++ controllers. Ctrl-C (here
+    _thread.interrupt_main from a timer, 0.2 s in) ends a 200 s run (2*10^5 periods of 20 RK4
+    substeps: a minute or more) within 5 s: the binding lets Python handle signals every 1000
+    periods, as the rigid simulator does."""
+    import _thread
+    import signal
+    import threading
+    import time
+
+    # interrupt_main does nothing while SIGINT is ignored (pytest started in the background by a
+    # non-interactive shell inherits that): Python's own handler, as in an interactive session.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    elastic = lwr_elastic(motor_viscous=1.0)
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    begin = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            simulate_elastic(
+                elastic, np.zeros(7), None, duration=200.0,
+                controller=MotorPD(kp=400.0, kd=40.0, q_d=np.zeros(7)), dt=1e-3, substeps=20,
+            )  # fmt: skip
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
+    assert time.perf_counter() - begin < 5.0

@@ -9,6 +9,7 @@
 #include "arrays.hpp"
 #include "dynid/elastic_simulator.hpp"
 #include "dynid/kuka_like_controller.hpp"
+#include "interruptible.hpp"
 #include "model.hpp"
 
 namespace dynid::binding {
@@ -77,9 +78,10 @@ py::tuple run_elastic(ElasticSimulator& simulator, ElasticController& controller
       RowMajorMap(q.mutable_data(), rows, n),   RowMajorMap(qd.mutable_data(), rows, n),
       RowMajorMap(th.mutable_data(), rows, n),  RowMajorMap(thd.mutable_data(), rows, n),
       RowMajorMap(tau.mutable_data(), rows, n), RowMajorMap(tau_J.mutable_data(), rows, n)};
+  InterruptibleElastic interruptible(controller);  // Ctrl-C stops a long run
   {
     py::gil_scoped_release release;
-    simulator.run(controller, x_q, x_qd, x_th, x_thd, periods, out);
+    simulator.run(interruptible, x_q, x_qd, x_th, x_thd, periods, out);
   }
   return py::make_tuple(q, qd, th, thd, tau, tau_J);
 }

@@ -9,6 +9,7 @@
 #include "arrays.hpp"
 #include "dynid/controllers.hpp"
 #include "dynid/simulator.hpp"
+#include "interruptible.hpp"
 #include "model.hpp"
 
 namespace dynid::binding {
@@ -39,25 +40,6 @@ class PythonController : public Controller {
  private:
   py::object function_;
   int n_;
-};
-
-// Lets Ctrl-C stop a long run of a built-in controller: every kCheckPeriods periods it takes the
-// GIL for a moment and lets Python run its signal handlers (KeyboardInterrupt propagates).
-class Interruptible : public Controller {
- public:
-  explicit Interruptible(Controller& inner) : inner_(inner) {}
-
-  void command(int k, double t, const VectorIn& q, const VectorIn& qd, VectorOut tau) override {
-    if (k % kCheckPeriods == kCheckPeriods - 1) {
-      py::gil_scoped_acquire gil;
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    }
-    inner_.command(k, t, q, qd, tau);
-  }
-
- private:
-  static constexpr int kCheckPeriods = 1000;
-  Controller& inner_;
 };
 
 Integrator parse_integrator(const std::string& method) {
