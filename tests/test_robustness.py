@@ -343,8 +343,12 @@ def test_foreign_log_columns_and_time_unit(tmp_path) -> None:
         assert np.array_equal(log.q, reference.q) and np.array_equal(log.tau, reference.tau)
         assert np.allclose(log.t, reference.t - reference.t[0], rtol=0, atol=1e-12)
         assert abs(log.fs - 200.0) < 1.0
-    with pytest.warns(UserWarning, match="sampling rate is 2e-07 Hz.*'ns'"):
-        io.load_log(csv_path, columns=mapping)  # the stamps read as seconds
+    # Nanosecond stamps read as seconds: refused (issue 22: a warning and a meaningless fit),
+    # unless the caller says the unit, then a warning.
+    with pytest.raises(ValueError, match=r"sampling rate is 2e-07 Hz.*'ns'.*--time-unit"):
+        io.load_log(csv_path, columns=mapping)
+    with pytest.warns(UserWarning, match="sampling rate is 2e-07 Hz"):
+        io.load_log(csv_path, columns=mapping, time_unit="s")
     with pytest.raises(ValueError, match="columns: nothing matches 'joint_\\*' for q"):
         io.load_log(csv_path, columns={"t": "stamp", "q": "joint_*", "tau": "effort_*"})
     with pytest.raises(ValueError, match=r"^time_unit: "):
@@ -356,20 +360,18 @@ def test_foreign_log_columns_and_time_unit(tmp_path) -> None:
         parse_columns("x=pos_*")
 
 
-def test_cli_foreign_log_warns_in_one_line(tmp_path, capsys) -> None:
+def test_cli_refuses_an_implausible_time_base_and_warns_in_one_line(tmp_path, capsys) -> None:
+    """Nanosecond stamps read as seconds: exit 2 with one line saying how (issue 22: a warning,
+    a meaningless result and exit 0); with --time-unit s the user insists: a one-line warning."""
     csv_path, _, _ = _foreign_log(tmp_path)
-    status = dynid.cli.main(
-        [
-            "identify",
-            csv_path,
-            "--columns",
-            "t=stamp,q=pos_*,tau=effort_*",
-            "--skip",
-            "4500",
-            "--output",
-            str(tmp_path / "out"),
-        ]
-    )
+    argv = ["identify", csv_path, "--columns", "t=stamp,q=pos_*,tau=effort_*", "--skip", "4500"]
+    assert dynid.cli.main([*argv, "--output", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("dynid identify: error: ros.csv: t: the median sampling rate") and (
+        err.count("\n") == 1 and "--time-unit" in err
+    ), err
+    assert not (tmp_path / "out").exists()
+    status = dynid.cli.main([*argv, "--time-unit", "s", "--output", str(tmp_path / "out")])
     err = capsys.readouterr().err
     assert status == 0
     assert "dynid identify: warning: ros.csv: t: the median sampling rate" in err

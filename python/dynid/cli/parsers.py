@@ -254,8 +254,9 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--time-unit",
         choices=("s", "ms", "us", "ns"),
-        default="s",
-        help="unit of the log's time stamps (default s)",
+        default=None,
+        help="unit of the log's time stamps (default: s, and a sampling rate outside 1 Hz to "
+        "100 kHz is an error; with the unit given, a warning)",
     )
 
 

@@ -224,16 +224,18 @@ def load_log(
     *,
     skip: int = 0,
     columns: Mapping[str, str] | None = None,
-    time_unit: str = "s",
+    time_unit: str | None = None,
 ) -> Log:
     """Load a log from an ``.npz`` or ``.csv`` file (formats in ``docs/data.md``).
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
     the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
     (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.io.columns`) and
-    ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count. Errors name the file
-    and what is missing or malformed; an implausible sampling rate or position range is a
-    warning that says what to check.
+    ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads seconds.
+    Errors name the file and what is missing or malformed. A sampling rate no robot log has
+    (outside PLAUSIBLE_RATE: nanosecond stamps read as seconds give 2e-7 Hz and a meaningless
+    fit) is an error, unless ``time_unit`` was given (then a warning: the caller said what the
+    stamps count); a position range no robot has is a warning.
     """
     path = Path(path)
     if not path.is_file():
@@ -245,7 +247,7 @@ def load_log(
         )
     skip = count(skip, "skip", 0)
     mapping = check_columns(columns) if columns is not None else None
-    seconds = time_scale(time_unit)
+    seconds = time_scale("s" if time_unit is None else time_unit)
     try:
         log = _load_npz(path, mapping) if suffix == ".npz" else _load_csv(path, mapping)
     except ValueError as exc:
@@ -256,7 +258,7 @@ def load_log(
         if skip > log.T - 2:
             raise ValueError(f"skip: {skip} leaves fewer than 2 of the {log.T} samples of {path}")
         log = log.slice(skip, None, note=f"skipped the first {skip} samples")
-    warn_implausible(log, path.name)
+    check_plausible(log, path.name, unit_given=time_unit is not None)
     return log
 
 
@@ -266,15 +268,23 @@ PLAUSIBLE_RATE = (1.0, 100e3)
 PLAUSIBLE_POSITION = 100.0
 
 
-def warn_implausible(log: Log, what: str) -> None:
-    """Warnings for values no robot log has: a sampling rate outside PLAUSIBLE_RATE (e.g.
-    nanosecond stamps read as seconds give 2e-7 Hz and a meaningless fit) or huge positions."""
+def check_plausible(log: Log, what: str, *, unit_given: bool) -> None:
+    """Refuse a sampling rate outside PLAUSIBLE_RATE (a warning when the caller gave the time
+    unit), and warn of positions beyond PLAUSIBLE_POSITION."""
     fs = log.fs
     if not PLAUSIBLE_RATE[0] <= fs <= PLAUSIBLE_RATE[1]:
         guess = "ns" if fs < 1e-3 else ("ms" if fs < 1.0 else "s")
+        message = (
+            f"{what}: t: the median sampling rate is {fs:.3g} Hz, implausible for a robot log "
+            f"({PLAUSIBLE_RATE[0]:g} Hz to {PLAUSIBLE_RATE[1]:g} Hz)"
+        )
+        if not unit_given:
+            raise ValueError(
+                f"{message}: the time stamps are probably not in seconds (e.g. {guess!r}); "
+                "give their unit with time_unit / --time-unit (s, ms, us, ns)"
+            )
         warnings.warn(
-            f"{what}: t: the median sampling rate is {fs:.3g} Hz, implausible for a robot log; "
-            f"check the unit of the time stamps (time_unit / --time-unit, e.g. {guess!r})",
+            f"{message} with time stamps in the unit given; check time_unit / --time-unit",
             UserWarning,
             stacklevel=3,
         )
