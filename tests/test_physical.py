@@ -382,6 +382,100 @@ def test_zero_weights_leave_a_joint_out(lwr, base, data):
     assert fit.residual_rms[0] > 100
 
 
+# --------------------------------------------------------------------------- units
+
+
+@pytest.mark.parametrize("weight", [1e200, 1e-200])
+def test_huge_and_tiny_weights_give_the_unweighted_fit(lwr, data, exact, weight):
+    """Weights 1e200 or 1e-200 on every joint (|w tau| up to ~5e201 or ~5e-199): a common
+    factor, so the unweighted estimate (1e-6 of the largest base value, as for the weights 7
+    above: the solver's tolerance ~1e-8 on the relative residual, amplified by the regressor's
+    conditioning). Issue 22: the squared norm of w tau overflowed (resp. underflowed) and the
+    fit explained zero torques (base values 70-90 % off)."""
+    Y, tau = data
+    weights = np.full(lwr.n, weight)
+    fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True, weights=weights)
+    scale = 1e-6 * np.abs(exact.base_values).max()
+    np.testing.assert_allclose(fit.base_values, exact.base_values, rtol=0, atol=scale)
+    assert np.all(fit.residual_rms < 1e-8 * np.abs(tau).max())  # as the unweighted fit's
+
+
+@pytest.mark.parametrize(("tau_exponent", "Y_exponent"), [(600, 0), (-600, 0), (0, 600)])
+def test_units_of_the_data_scale_the_estimate_by_powers_of_two(
+    lwr, data, exact, tau_exponent, Y_exponent
+):
+    """tau * 2^b and Y * 2^a (|tau| ~ 2e182 or 2e-179, |Y| ~ 2e182), the margin in the same
+    units (margin * 2^(b - a)): the estimate is the unscaled one times 2^(b - a), the residual
+    RMS the unscaled one times 2^b. The solver sees the same problem (Y and tau are scaled by
+    powers of two before it), so to rounding (1e-12 of the largest parameter), far below its
+    tolerance. Issue 22: the solver failed on each (an error, or a margin violated by 5 %)."""
+    Y, tau = data
+    e = tau_exponent - Y_exponent
+    fit = physical_least_squares(
+        lwr,
+        np.ldexp(Y, Y_exponent),
+        np.ldexp(tau, tau_exponent),
+        rotor=True,
+        friction=True,
+        margin=np.ldexp(1e-6, e),
+    )
+    assert fit.status == "optimal" and fit.robot.is_physically_consistent()
+    np.testing.assert_allclose(
+        np.ldexp(fit.theta, -e), exact.theta, rtol=0, atol=1e-12 * np.abs(exact.theta).max()
+    )
+    np.testing.assert_allclose(
+        np.ldexp(fit.residual_rms, -tau_exponent), exact.residual_rms, rtol=1e-9, atol=1e-20
+    )
+    assert fit.min_eigenvalues.min() >= np.ldexp(1e-6, e) * (1 - 1e-12)  # the margin holds
+
+
+@pytest.mark.parametrize("e", [600, -600])
+def test_prior_and_bounds_in_the_units_of_the_data_scale_with_them(lwr, data, e):
+    """The whole problem in other units: tau, the margin, the mass bounds, the total mass and
+    the prior (the truth with every mass 10 % larger; all its parameters) times 2^e. The
+    estimate is the one in SI units times 2^e, to rounding (1e-12 of the largest parameter:
+    the solver sees the same problem), and the objective (relative) the same."""
+    Y, tau = data
+    prior = lwr.copy()
+    prior.params = lwr.params * np.array([1.1] + [1.0] * 9)
+    bounds, total = np.tile([0.1, 20.0], (lwr.n, 1)), np.array([1.0, 30.0])
+    options = {"rotor": True, "friction": True, "prior_weight": 1e-4}
+    si = physical_least_squares(
+        lwr, Y, tau, prior=prior, mass_bounds=bounds, total_mass=total, **options
+    )
+    scaled_prior = prior.copy()
+    scaled_prior.params = np.ldexp(prior.params, e)
+    scaled_prior.Ia, scaled_prior.Fv, scaled_prior.Fs = (
+        np.ldexp(x, e) for x in (prior.Ia, prior.Fv, prior.Fs)
+    )
+    fit = physical_least_squares(
+        lwr,
+        Y,
+        np.ldexp(tau, e),
+        prior=scaled_prior,
+        mass_bounds=np.ldexp(bounds, e),
+        total_mass=np.ldexp(total, e),
+        margin=np.ldexp(1e-6, e),
+        **options,
+    )
+    np.testing.assert_allclose(
+        np.ldexp(fit.theta, -e), si.theta, rtol=0, atol=1e-12 * np.abs(si.theta).max()
+    )
+    assert fit.objective == pytest.approx(si.objective, rel=1e-9)
+
+
+def test_huge_torques_with_the_default_margin_keep_the_base_values(lwr, data, exact):
+    """tau * 2^600 with the default margin (1e-6, now 2^-600 times smaller relative to the
+    parameters): the standard parameters the data do not see may move, the base values are the
+    unscaled ones times 2^600 (1e-6 of the largest, the tolerance used above)."""
+    Y, tau = data
+    fit = physical_least_squares(lwr, Y, np.ldexp(tau, 600), rotor=True, friction=True)
+    scale = 1e-6 * np.abs(exact.base_values).max()
+    np.testing.assert_allclose(
+        np.ldexp(fit.base_values, -600), exact.base_values, rtol=0, atol=scale
+    )
+
+
 # --------------------------------------------------------------------------- bad arguments
 
 

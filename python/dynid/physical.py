@@ -32,6 +32,20 @@ scaled to unit norm, the torques to unit norm) and the objective is written as t
 norm of the stacked residual and prior terms (a second-order cone; same minimiser as the sum of
 squares), so the solver's absolute tolerance ~1e-8 applies to the residual itself, not to its
 square.
+
+Units: before anything else the weights are divided by the power of two that brings their
+largest to [0.5, 1) (a common factor cancels in the relative residual), Y and tau by those that
+bring their largest magnitude to [0.5, 1), as :func:`dynid.least_squares` does; the parameters
+are then estimated in units of 2^e, e = (tau's exponent) - (Y's), and multiplied back by 2^e at
+the end. The margin, the mass bounds and the prior, which are in the parameters' units, are
+divided by 2^e too. So the solver sees the same problem whatever the magnitudes of Y, tau and
+the weights (issue 22: |w tau| beyond ~1e154 overflowed the torques' norm and fitted zero
+torques, below ~1e-162 it underflowed to the same effect): Y times 2^a, tau times 2^b, the
+weights times 2^c, and margin, mass_bounds, total_mass and the prior times 2^(b - a) give the
+estimate times 2^(b - a), exactly (other factors: the same problem up to rounding). The margin,
+the bounds and the prior do not follow the data's units by themselves: with tau times 2^b and
+the default margin, the margin is 2^-b times smaller relative to the parameters (negligible for
+b > 0; for b << 0 it can exclude them: give margin in the parameters' units).
 """
 
 from __future__ import annotations
@@ -49,8 +63,10 @@ from numpy.typing import ArrayLike, NDArray
 from . import _checks as checks
 from ._checks import positive
 from ._equality import ValueEquality
+from ._qr import exponent
 from .base_parameters import base_parameters
 from .errors import PhysicalIdentificationError
+from .identify import _unscale
 from .physical_arguments import (
     check_data,
     check_mass_bounds,
@@ -196,12 +212,30 @@ def physical_least_squares(
     lower, upper = check_mass_bounds(mass_bounds, n)
     total = check_total_mass(total_mass)
 
+    # Units (module docstring): weights, Y and tau by powers of two (exact), the parameters, so
+    # the margin, the bounds and the prior, in units of 2^unit; everything below until the
+    # unscaling is in these units.
+    y_max, tau_max = np.array([np.abs(Y3).max()]), np.array([np.abs(tau2).max()])
+    sizes = f"max |Y| {y_max[0]:.3g}, max |tau| {tau_max[0]:.3g}"
+    y_exp, tau_exp = exponent(y_max) or 0, exponent(tau_max) or 0
+    unit = tau_exp - y_exp
+    Y3, tau2 = np.ldexp(Y3, -y_exp), np.ldexp(tau2, -tau_exp)
+    w = np.ldexp(w, -(exponent(w) or 0))
+    margin_s = float(np.ldexp(margin, -unit))
+    if lower is not None:
+        assert upper is not None  # check_mass_bounds gives both or neither
+        lower, upper = np.ldexp(lower, -unit), np.ldexp(upper, -unit)
+    if total is not None:
+        total = (float(np.ldexp(total[0], -unit)), float(np.ldexp(total[1], -unit)))
+    if prior_x is not None:
+        prior_x = np.ldexp(prior_x, -unit)
+
     # Scaled, compressed residual: rows weighted, columns to unit norm, torques to unit norm,
     # then A_s = Q R so that ||A_s z - b_s||^2 = ||R z - Q^T b_s||^2 + r0^2 (r0 constant).
     A = (Y3 * w[:, :, None]).reshape(-1, P + k)
     b = (tau2 * w).reshape(-1)
     column = _column_norms(A)
-    b_norm = float(np.linalg.norm(b)) or 1.0
+    b_norm = float(_column_norms(b[:, None])[0])  # 1 for b = 0
     R, c, r0 = _compressed(A / column, b / b_norm)
 
     J = [cp.Variable((4, 4), symmetric=True, name=f"J{i + 1}") for i in range(n)]
@@ -212,12 +246,11 @@ def physical_least_squares(
     parts += [v for v in (drive, free) if v is not None]
     x = cp.hstack(parts)
     terms = [R @ cp.multiply(column / b_norm, x) - c, np.array([r0])]
-    constraints = [Ji - margin * np.eye(4) >> 0 for Ji in J]
+    constraints = [Ji - margin_s * np.eye(4) >> 0 for Ji in J]
     if free is not None and nonnegative.any():
         constraints += [free[np.flatnonzero(nonnegative)] >= 0]
     masses = cp.hstack([Ji[3, 3] for Ji in J])
-    if lower is not None:
-        assert upper is not None  # check_mass_bounds gives both or neither
+    if lower is not None and upper is not None:
         constraints += [masses >= lower]
         finite = np.isfinite(upper)
         if finite.any():
@@ -256,7 +289,7 @@ def physical_least_squares(
     projected, worst = [], 0.0
     for i, Ji in enumerate(J):
         raw = 0.5 * (Ji.value + Ji.value.T)
-        fixed = nearest_with_margin(raw, margin)
+        fixed = nearest_with_margin(raw, margin_s)
         change = float(np.linalg.norm(fixed - raw) / np.linalg.norm(raw))
         if change > 0:
             projected.append(i)
@@ -272,11 +305,16 @@ def physical_least_squares(
     extra = np.asarray(free.value, dtype=float) if free is not None else np.zeros(0)
     extra[nonnegative] = np.maximum(extra[nonnegative], 0.0)
     theta = np.concatenate([params.reshape(-1), drive_values, extra])
+    residual_rms = np.sqrt(np.mean((tau2 - Y3 @ theta) ** 2, axis=0))  # |tau2| < 1: no overflow
+    # Back to the units given (exact powers of two), a ValueError if they overflow.
+    theta = _unscale(theta, unit, "Y, tau", "the estimate theta ~ tau / Y", sizes)
+    residual_rms = _unscale(residual_rms, tau_exp, "tau", "the residual RMS", sizes)
+    params = theta[: 10 * n].reshape(n, 10).copy()
+    drive_values, extra = theta[10 * n : P].copy(), theta[P:].copy()
     identified = _identified_robot(robot, params, drive_values, rotor, friction)
     min_eig = np.array([np.linalg.eigvalsh(pseudo_inertia(p))[0] for p in params])
     mass_eig = _check(identified, min_eig)
     base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
-    residual = tau2 - Y3 @ theta
     return PhysicalResult(
         robot=identified,
         params=params,
@@ -287,7 +325,7 @@ def physical_least_squares(
         theta=theta,
         base_values=base.beta @ theta[:P],
         base_names=list(base.names),
-        residual_rms=np.sqrt(np.mean(residual**2, axis=0)),
+        residual_rms=residual_rms,
         status=status,
         objective=float(problem.value) ** 2,
         solver=SOLVER,
