@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -208,6 +209,75 @@ def test_offsets_as_extra_columns_are_recovered(lwr, base, data):
     np.testing.assert_allclose(fit.base_values, true, rtol=1e-6, atol=1e-9 * np.abs(true).max())
 
 
+# --------------------------------------------------------------------------- identifiability
+
+
+@pytest.fixture(scope="module")
+def unexciting(lwr):
+    """Data that cannot determine the 62 base parameters: one sample (7 rows), and 300 random
+    configurations at rest (qd = qdd = 0: only gravity acts, the inertias are invisible)."""
+    q, qd, qdd = states(lwr, T, seed=41)
+    still = np.zeros_like(qd)
+    return {"one sample": (q[:1], qd[:1], qdd[:1]), "static": (q, still, still)}
+
+
+def test_well_excited_data_have_full_rank_and_no_warning(lwr, base, data):
+    """The 300 random states excite every base parameter (the unconstrained least squares on
+    the same data has full rank): rank 62 of 62, nothing unidentified, no UserWarning."""
+    Y, tau = data
+    assert least_squares(Y[..., base.independent], tau).rank == base.count
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True)
+    assert not [w for w in caught if issubclass(w.category, UserWarning)]
+    assert fit.rank == fit.parameter_count == base.count and fit.unidentified == []
+
+
+@pytest.mark.parametrize(("case", "rank"), [("one sample", 7), ("static", 12)])
+def test_data_that_do_not_determine_the_parameters_warn_and_report_the_rank(
+    lwr, base, unexciting, case, rank
+):
+    """Issue 22: these fits were "optimal" without a word, with unexcited base values off by
+    100 % and more. Now a UserWarning says the data do not excite them and nothing but the
+    solver fixes them, and the result reports the rank: 7 (one row per joint) and 12 (at rest
+    the torque is gravity, a function of the masses and first moments only: the 12 base
+    parameters m*, e.g. mx2, mz2R, my7); the same as the SVD of the column-scaled base
+    regressor (numpy, 1e-10 as least_squares). The parameters not named unidentified are
+    determined by these noise-free data: the true values (1e-6 relative)."""
+    q, qd, qdd = unexciting[case]
+    Y = lwr.regressor(q, qd, qdd, rotor=True, friction=True)
+    with pytest.warns(UserWarning, match="do not excite.* Without a prior nothing fixes"):
+        fit = physical_least_squares(lwr, Y, lwr.rnea(q, qd, qdd), rotor=True, friction=True)
+    Yb = Y[..., base.independent].reshape(-1, base.count)
+    norms = np.linalg.norm(Yb, axis=0)
+    singular = np.linalg.svd(Yb / np.where(norms > 0, norms, 1.0), compute_uv=False)
+    assert fit.rank == rank == np.count_nonzero(singular > 1e-10 * singular[0])
+    assert fit.parameter_count == base.count
+    determined = [j for j, name in enumerate(base.names) if name not in fit.unidentified]
+    assert len(fit.unidentified) == base.count - len(determined)
+    if case == "static":
+        assert [base.names[j] for j in determined] == [
+            name for name in base.names if name.startswith("m")
+        ]
+    true = base.values(lwr)
+    np.testing.assert_allclose(fit.base_values[determined], true[determined], rtol=1e-6)
+
+
+def test_with_a_prior_the_warning_says_the_prior_decides(lwr, unexciting):
+    """Static data and the truth as prior: the warning says the 50 unexcited directions come
+    from the prior, and the estimate is the prior (every standard parameter to 1e-6 of the
+    largest), a legitimate result whose rank (12) is reported."""
+    q, qd, qdd = unexciting["static"]
+    Y = lwr.regressor(q, qd, qdd, rotor=True, friction=True)
+    with pytest.warns(UserWarning, match="come from the prior"):
+        fit = physical_least_squares(
+            lwr, Y, lwr.rnea(q, qd, qdd), rotor=True, friction=True, prior=lwr, prior_weight=1e-4
+        )
+    truth = lwr.parameter_vector(True, True)
+    np.testing.assert_allclose(fit.theta, truth, rtol=0, atol=1e-6 * np.abs(truth).max())
+    assert fit.rank == 12 and len(fit.unidentified) == 50
+
+
 # --------------------------------------------------------------------------- constraints
 
 
@@ -371,15 +441,112 @@ def test_stacked_rows_and_per_row_weights_are_the_same_problem(lwr, data, exact)
 def test_zero_weights_leave_a_joint_out(lwr, base, data):
     """Joint 1's rows weighted 0 and its torques replaced by garbage: the other joints' data
     still give their base values (those of rows 2..7 are a subset; compared through the
-    residual: the fit explains joints 2-7 to 1e-7 of their torques)."""
+    residual: the fit explains joints 2-7 to 1e-7 of their torques). The terms acting on joint
+    1 alone (Iyy1R, Fv1, Fs1) are then unexcited: a UserWarning, rank 59 of 62."""
     Y, tau = data
     garbage = tau.copy()
     garbage[:, 0] = 1e3
     weights = np.ones(lwr.n)
     weights[0] = 0.0
-    fit = physical_least_squares(lwr, Y, garbage, rotor=True, friction=True, weights=weights)
+    with pytest.warns(UserWarning, match="rank 59 < 62"):
+        fit = physical_least_squares(lwr, Y, garbage, rotor=True, friction=True, weights=weights)
+    assert fit.rank == 59 and sorted(fit.unidentified) == ["Fs1", "Fv1", "Iyy1R"]
     assert np.all(fit.residual_rms[1:] < 1e-7 * np.abs(tau).max())
     assert fit.residual_rms[0] > 100
+
+
+# --------------------------------------------------------------------------- units
+
+
+@pytest.mark.parametrize("weight", [1e200, 1e-200])
+def test_huge_and_tiny_weights_give_the_unweighted_fit(lwr, data, exact, weight):
+    """Weights 1e200 or 1e-200 on every joint (|w tau| up to ~5e201 or ~5e-199): a common
+    factor, so the unweighted estimate (1e-6 of the largest base value, as for the weights 7
+    above: the solver's tolerance ~1e-8 on the relative residual, amplified by the regressor's
+    conditioning). Issue 22: the squared norm of w tau overflowed (resp. underflowed) and the
+    fit explained zero torques (base values 70-90 % off)."""
+    Y, tau = data
+    weights = np.full(lwr.n, weight)
+    fit = physical_least_squares(lwr, Y, tau, rotor=True, friction=True, weights=weights)
+    scale = 1e-6 * np.abs(exact.base_values).max()
+    np.testing.assert_allclose(fit.base_values, exact.base_values, rtol=0, atol=scale)
+    assert np.all(fit.residual_rms < 1e-8 * np.abs(tau).max())  # as the unweighted fit's
+
+
+@pytest.mark.parametrize(("tau_exponent", "Y_exponent"), [(600, 0), (-600, 0), (0, 600)])
+def test_units_of_the_data_scale_the_estimate_by_powers_of_two(
+    lwr, data, exact, tau_exponent, Y_exponent
+):
+    """tau * 2^b and Y * 2^a (|tau| ~ 2e182 or 2e-179, |Y| ~ 2e182), the margin in the same
+    units (margin * 2^(b - a)): the estimate is the unscaled one times 2^(b - a), the residual
+    RMS the unscaled one times 2^b. The solver sees the same problem (Y and tau are scaled by
+    powers of two before it), so to rounding (1e-12 of the largest parameter), far below its
+    tolerance. Issue 22: the solver failed on each (an error, or a margin violated by 5 %)."""
+    Y, tau = data
+    e = tau_exponent - Y_exponent
+    fit = physical_least_squares(
+        lwr,
+        np.ldexp(Y, Y_exponent),
+        np.ldexp(tau, tau_exponent),
+        rotor=True,
+        friction=True,
+        margin=np.ldexp(1e-6, e),
+    )
+    assert fit.status == "optimal" and fit.robot.is_physically_consistent()
+    np.testing.assert_allclose(
+        np.ldexp(fit.theta, -e), exact.theta, rtol=0, atol=1e-12 * np.abs(exact.theta).max()
+    )
+    np.testing.assert_allclose(
+        np.ldexp(fit.residual_rms, -tau_exponent), exact.residual_rms, rtol=1e-9, atol=1e-20
+    )
+    assert fit.min_eigenvalues.min() >= np.ldexp(1e-6, e) * (1 - 1e-12)  # the margin holds
+
+
+@pytest.mark.parametrize("e", [600, -600])
+def test_prior_and_bounds_in_the_units_of_the_data_scale_with_them(lwr, data, e):
+    """The whole problem in other units: tau, the margin, the mass bounds, the total mass and
+    the prior (the truth with every mass 10 % larger; all its parameters) times 2^e. The
+    estimate is the one in SI units times 2^e, to rounding (1e-12 of the largest parameter:
+    the solver sees the same problem), and the objective (relative) the same."""
+    Y, tau = data
+    prior = lwr.copy()
+    prior.params = lwr.params * np.array([1.1] + [1.0] * 9)
+    bounds, total = np.tile([0.1, 20.0], (lwr.n, 1)), np.array([1.0, 30.0])
+    options = {"rotor": True, "friction": True, "prior_weight": 1e-4}
+    si = physical_least_squares(
+        lwr, Y, tau, prior=prior, mass_bounds=bounds, total_mass=total, **options
+    )
+    scaled_prior = prior.copy()
+    scaled_prior.params = np.ldexp(prior.params, e)
+    scaled_prior.Ia, scaled_prior.Fv, scaled_prior.Fs = (
+        np.ldexp(x, e) for x in (prior.Ia, prior.Fv, prior.Fs)
+    )
+    fit = physical_least_squares(
+        lwr,
+        Y,
+        np.ldexp(tau, e),
+        prior=scaled_prior,
+        mass_bounds=np.ldexp(bounds, e),
+        total_mass=np.ldexp(total, e),
+        margin=np.ldexp(1e-6, e),
+        **options,
+    )
+    np.testing.assert_allclose(
+        np.ldexp(fit.theta, -e), si.theta, rtol=0, atol=1e-12 * np.abs(si.theta).max()
+    )
+    assert fit.objective == pytest.approx(si.objective, rel=1e-9)
+
+
+def test_huge_torques_with_the_default_margin_keep_the_base_values(lwr, data, exact):
+    """tau * 2^600 with the default margin (1e-6, now 2^-600 times smaller relative to the
+    parameters): the standard parameters the data do not see may move, the base values are the
+    unscaled ones times 2^600 (1e-6 of the largest, the tolerance used above)."""
+    Y, tau = data
+    fit = physical_least_squares(lwr, Y, np.ldexp(tau, 600), rotor=True, friction=True)
+    scale = 1e-6 * np.abs(exact.base_values).max()
+    np.testing.assert_allclose(
+        np.ldexp(fit.base_values, -600), exact.base_values, rtol=0, atol=scale
+    )
 
 
 # --------------------------------------------------------------------------- bad arguments
@@ -426,6 +593,8 @@ def _call(lwr, data, **changes):
         ({"margin": np.inf}, "margin"),
         ({"extra_columns": -1}, "extra_columns"),
         ({"extra_columns": 2}, "Y"),
+        ({"rank_tolerance": 0.0}, "rank_tolerance"),
+        ({"rank_tolerance": 1.0}, "rank_tolerance"),
     ],
 )
 def test_bad_arguments_raise_value_errors_naming_them(lwr, data, changes, name):
@@ -522,16 +691,17 @@ def test_identify_log_checks_the_physical_options(lwr, log):
 
 def test_identify_log_physical_with_excluded_joints_and_ols(lwr, log):
     """Joint 1's rows left out (weight 0) and its torques replaced by garbage, OLS: joint 1's
-    own terms (Ia1, Fv1, Fs1, offset) are no longer excited, a RuntimeWarning (the least squares
-    would raise); the physical fit still explains joints 2-7 to 1e-6 of their torques and
-    ignores joint 1."""
+    own terms (Iyy1R, Fv1, Fs1, offset) are no longer excited, a RuntimeWarning (the least
+    squares would raise) and the physical fit's UserWarning; the physical fit still explains
+    joints 2-7 to 1e-6 of their torques and ignores joint 1."""
     log, _offsets = log
     tau = log.tau.copy()
     tau[:, 0] = 50.0
     garbage = log.replace(tau=tau)
     with pytest.raises(dynid.RankDeficientError):
         identify_log(garbage, lwr, rotor=True, friction=True, offset=True, exclude_joints=(0,))
-    with pytest.warns(RuntimeWarning, match="do not excite"):
+    excited = pytest.warns(RuntimeWarning, match="do not excite")
+    with excited, pytest.warns(UserWarning, match="rank 65 < 69"):
         result = identify_log(
             garbage,
             lwr,

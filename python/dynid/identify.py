@@ -195,9 +195,14 @@ CHUNK_SAMPLES = 4096
 def _check_options(method: str, on_rank_deficient: str, rank_tolerance: float) -> tuple[str, str]:
     method = _choice(method, METHODS, "method")
     on_rank_deficient = _choice(on_rank_deficient, ON_RANK_DEFICIENT, "on_rank_deficient")
+    _check_rank_tolerance(rank_tolerance)
+    return method, on_rank_deficient
+
+
+def _check_rank_tolerance(rank_tolerance: float) -> float:
     if not (isinstance(rank_tolerance, (int, float)) and 0.0 < rank_tolerance < 1.0):
         raise ValueError(f"rank_tolerance: expected a number in (0, 1), got {rank_tolerance!r}")
-    return method, on_rank_deficient
+    return float(rank_tolerance)
 
 
 def solve_factors(

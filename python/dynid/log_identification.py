@@ -329,7 +329,8 @@ def identify_log(
     :func:`dynid.link_frames.express_in_frames_of` when needed); ``prior_weight`` defaults to
     ``DEFAULT_PRIOR_WEIGHT`` when a prior is given. A log that does not excite every base
     parameter is then a RuntimeWarning, not an error: the constraints and the prior fix the
-    unexcited directions (without a prior, any values the constraints allow). Raises
+    unexcited directions (without a prior, any values the constraints allow), which the physical
+    fit's UserWarning says too (its extra columns named ``extra[k]``). Raises
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):

@@ -26,17 +26,42 @@ parameters by 10 % is worth 0.1 % relative RMS residual. Directions the data can
 null space of Y) cost nothing in the first term and come from the prior; well-excited ones
 follow the data as long as prior_weight is small against the residual's curvature.
 
+Identifiability: the data determine at most the base parameters (beta pi, Y pi = Y_b beta pi)
+and the extra coefficients, and only those the weighted data excite. Their number is the rank
+of the weighted regressor's base and extra columns, computed as :func:`dynid.least_squares`
+computes it (singular values of the column-scaled matrix above ``rank_tolerance`` times the
+largest; here of the compressed triangle the solver sees). Below the count the result says so
+(``rank``, ``parameter_count``, ``unidentified``) and a UserWarning names the parameters:
+along the unexcited directions the estimate is the prior's, or, without a prior, whatever
+point of the optimal set the interior-point solver stops at (not the data's: such base
+values can be off by 100 % and more on noise-free data, the residual being optimal either way).
+
 The solver is Clarabel (interior point, open source, PyPI) through cvxpy. The problem is solved in
 scaled units (the stacked weighted regressor is QR-compressed to its P x P triangle, its columns
 scaled to unit norm, the torques to unit norm) and the objective is written as the Euclidean
 norm of the stacked residual and prior terms (a second-order cone; same minimiser as the sum of
 squares), so the solver's absolute tolerance ~1e-8 applies to the residual itself, not to its
 square.
+
+Units: before anything else the weights are divided by the power of two that brings their
+largest to [0.5, 1) (a common factor cancels in the relative residual), Y and tau by those that
+bring their largest magnitude to [0.5, 1), as :func:`dynid.least_squares` does; the parameters
+are then estimated in units of 2^e, e = (tau's exponent) - (Y's), and multiplied back by 2^e at
+the end. The margin, the mass bounds and the prior, which are in the parameters' units, are
+divided by 2^e too. So the solver sees the same problem whatever the magnitudes of Y, tau and
+the weights (issue 22: |w tau| beyond ~1e154 overflowed the torques' norm and fitted zero
+torques, below ~1e-162 it underflowed to the same effect): Y times 2^a, tau times 2^b, the
+weights times 2^c, and margin, mass_bounds, total_mass and the prior times 2^(b - a) give the
+estimate times 2^(b - a), exactly (other factors: the same problem up to rounding). The margin,
+the bounds and the prior do not follow the data's units by themselves: with tau times 2^b and
+the default margin, the margin is 2^-b times smaller relative to the parameters (negligible for
+b > 0; for b << 0 it can exclude them: give margin in the parameters' units).
 """
 
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -49,8 +74,10 @@ from numpy.typing import ArrayLike, NDArray
 from . import _checks as checks
 from ._checks import positive
 from ._equality import ValueEquality
+from ._qr import exponent, solve_triangular_system, upper_triangle
 from .base_parameters import base_parameters
 from .errors import PhysicalIdentificationError
+from .identify import IDENTIFIABLE_TOLERANCE, _check_rank_tolerance, _rank_message, _unscale
 from .physical_arguments import (
     check_data,
     check_mass_bounds,
@@ -100,6 +127,9 @@ class PhysicalResult(ValueEquality):
     theta: NDArray[np.float64]  #: (P + extra_columns,) the whole estimate, Y @ theta predicts tau
     base_values: NDArray[np.float64]  #: base.beta @ pi (p,), base of the torque regressor
     base_names: list[str]
+    rank: int  #: numerical rank of the weighted regressor's base and extra columns
+    parameter_count: int  #: their number, p + extra_columns: full rank when rank equals it
+    unidentified: list[str]  #: those (base_names, then extra[k]) the data leave undetermined
     residual_rms: NDArray[np.float64]  #: (n,) per joint RMS of tau - Y theta (torque units)
     status: str  #: the solver's status ("optimal")
     objective: float  #: the cost minimised (relative squared residual + prior term)
@@ -127,6 +157,7 @@ def physical_least_squares(
     margin: float = DEFAULT_MARGIN,
     extra_columns: int = 0,
     nonnegative_extra: ArrayLike | None = None,
+    rank_tolerance: float = 1e-10,
 ) -> PhysicalResult:
     """Physically consistent least squares over the standard parameters (module docstring).
 
@@ -166,6 +197,15 @@ def physical_least_squares(
         asymmetric friction coefficients Fv+, Fv-, Fs+, Fs- of
         :mod:`dynid.friction_models`); after the solve, values negative by a solver tolerance
         are set to 0, as for Ia, Fv, Fs.
+    rank_tolerance
+        The rank test's, as for :func:`dynid.least_squares`: in (0, 1).
+
+    Identifiability (module docstring): ``result.rank`` of ``result.parameter_count`` base
+    parameters and extra coefficients are determined by the weighted data; ``unidentified``
+    names those entering a direction the data do not see (as least_squares' infinite standard
+    deviations; the extra columns are ``extra[k]``). When rank < parameter_count a UserWarning
+    names them and says what fixes them instead: the prior, or without one nothing but the
+    constraints and where the solver stops.
 
     After the solve, each link's pseudo-inertia is moved to the nearest matrix (Frobenius norm)
     with eigenvalues >= margin, and Ia, Fv, Fs negative by a solver tolerance set to 0: this
@@ -195,14 +235,37 @@ def physical_least_squares(
     prior_x = check_prior(prior, robot, rotor, friction) if prior is not None else None
     lower, upper = check_mass_bounds(mass_bounds, n)
     total = check_total_mass(total_mass)
+    rank_tolerance = _check_rank_tolerance(rank_tolerance)
+    base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
+
+    # Units (module docstring): weights, Y and tau by powers of two (exact), the parameters, so
+    # the margin, the bounds and the prior, in units of 2^unit; everything below until the
+    # unscaling is in these units.
+    y_max, tau_max = np.array([np.abs(Y3).max()]), np.array([np.abs(tau2).max()])
+    sizes = f"max |Y| {y_max[0]:.3g}, max |tau| {tau_max[0]:.3g}"
+    y_exp, tau_exp = exponent(y_max) or 0, exponent(tau_max) or 0
+    unit = tau_exp - y_exp
+    Y3, tau2 = np.ldexp(Y3, -y_exp), np.ldexp(tau2, -tau_exp)
+    w = np.ldexp(w, -(exponent(w) or 0))
+    margin_s = float(np.ldexp(margin, -unit))
+    if lower is not None:
+        assert upper is not None  # check_mass_bounds gives both or neither
+        lower, upper = np.ldexp(lower, -unit), np.ldexp(upper, -unit)
+    if total is not None:
+        total = (float(np.ldexp(total[0], -unit)), float(np.ldexp(total[1], -unit)))
+    if prior_x is not None:
+        prior_x = np.ldexp(prior_x, -unit)
 
     # Scaled, compressed residual: rows weighted, columns to unit norm, torques to unit norm,
     # then A_s = Q R so that ||A_s z - b_s||^2 = ||R z - Q^T b_s||^2 + r0^2 (r0 constant).
     A = (Y3 * w[:, :, None]).reshape(-1, P + k)
     b = (tau2 * w).reshape(-1)
     column = _column_norms(A)
-    b_norm = float(np.linalg.norm(b)) or 1.0
+    b_norm = float(_column_norms(b[:, None])[0])  # 1 for b = 0
     R, c, r0 = _compressed(A / column, b / b_norm)
+    names = [*base.names, *(f"extra[{j}]" for j in range(k))]
+    seen = np.concatenate([base.independent, P + np.arange(k)])
+    rank, unidentified, rank_message = _identifiability(R, c, seen, names, rank_tolerance)
 
     J = [cp.Variable((4, 4), symmetric=True, name=f"J{i + 1}") for i in range(n)]
     drive_count = (n if rotor else 0) + (2 * n if friction else 0)
@@ -212,12 +275,11 @@ def physical_least_squares(
     parts += [v for v in (drive, free) if v is not None]
     x = cp.hstack(parts)
     terms = [R @ cp.multiply(column / b_norm, x) - c, np.array([r0])]
-    constraints = [Ji - margin * np.eye(4) >> 0 for Ji in J]
+    constraints = [Ji - margin_s * np.eye(4) >> 0 for Ji in J]
     if free is not None and nonnegative.any():
         constraints += [free[np.flatnonzero(nonnegative)] >= 0]
     masses = cp.hstack([Ji[3, 3] for Ji in J])
-    if lower is not None:
-        assert upper is not None  # check_mass_bounds gives both or neither
+    if lower is not None and upper is not None:
         constraints += [masses >= lower]
         finite = np.isfinite(upper)
         if finite.any():
@@ -256,7 +318,7 @@ def physical_least_squares(
     projected, worst = [], 0.0
     for i, Ji in enumerate(J):
         raw = 0.5 * (Ji.value + Ji.value.T)
-        fixed = nearest_with_margin(raw, margin)
+        fixed = nearest_with_margin(raw, margin_s)
         change = float(np.linalg.norm(fixed - raw) / np.linalg.norm(raw))
         if change > 0:
             projected.append(i)
@@ -272,11 +334,30 @@ def physical_least_squares(
     extra = np.asarray(free.value, dtype=float) if free is not None else np.zeros(0)
     extra[nonnegative] = np.maximum(extra[nonnegative], 0.0)
     theta = np.concatenate([params.reshape(-1), drive_values, extra])
+    residual_rms = np.sqrt(np.mean((tau2 - Y3 @ theta) ** 2, axis=0))  # |tau2| < 1: no overflow
+    # Back to the units given (exact powers of two), a ValueError if they overflow.
+    theta = _unscale(theta, unit, "Y, tau", "the estimate theta ~ tau / Y", sizes)
+    residual_rms = _unscale(residual_rms, tau_exp, "tau", "the residual RMS", sizes)
+    params = theta[: 10 * n].reshape(n, 10).copy()
+    drive_values, extra = theta[10 * n : P].copy(), theta[P:].copy()
     identified = _identified_robot(robot, params, drive_values, rotor, friction)
     min_eig = np.array([np.linalg.eigvalsh(pseudo_inertia(p))[0] for p in params])
     mass_eig = _check(identified, min_eig)
-    base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
-    residual = tau2 - Y3 @ theta
+    if rank_message:
+        decided = (
+            f"These directions come from the prior (prior_weight {prior_weight:g}), not from "
+            "the data."
+            if prior is not None
+            else "Without a prior nothing fixes these directions: the estimate along them is "
+            "wherever the solver stopped within the physical constraints, arbitrary (give a "
+            "prior)."
+        )
+        warnings.warn(
+            f"physical_least_squares: {rank_message} {decided} result.rank and "
+            "result.unidentified report them.",
+            UserWarning,
+            stacklevel=2,
+        )
     return PhysicalResult(
         robot=identified,
         params=params,
@@ -287,7 +368,10 @@ def physical_least_squares(
         theta=theta,
         base_values=base.beta @ theta[:P],
         base_names=list(base.names),
-        residual_rms=np.sqrt(np.mean(residual**2, axis=0)),
+        rank=rank,
+        parameter_count=seen.size,
+        unidentified=unidentified,
+        residual_rms=residual_rms,
         status=status,
         objective=float(problem.value) ** 2,
         solver=SOLVER,
@@ -305,6 +389,7 @@ def physical_least_squares(
             "extra_columns": k,
             "nonnegative_extra": np.flatnonzero(nonnegative).tolist(),
             "prior": prior is not None,
+            "rank_tolerance": rank_tolerance,
         },
     )
 
@@ -395,6 +480,29 @@ def _check(robot: Robot, min_eig: NDArray[np.float64]) -> float:
             "not_positive_definite",
         )
     return smallest
+
+
+def _identifiability(
+    R: NDArray[np.float64],
+    c: NDArray[np.float64],
+    columns: NDArray[np.int64],
+    names: list[str],
+    tolerance: float,
+) -> tuple[int, list[str], str]:
+    """The rank of the fit's system A z = b restricted to ``columns`` (R, c: its compressed
+    triangle, ||A z - b||^2 = ||R z - c||^2 + r0^2), the names of the parameters entering a
+    null direction and, below full rank, dynid.least_squares' message naming them ("" at full
+    rank): least_squares' rank test (_qr.solve_triangular_system) on the triangle of
+    [A[:, columns] | b], padded with zero rows when the data have fewer rows than columns."""
+    count = columns.size
+    factor = np.zeros((count + 1, count + 1))
+    top = upper_triangle(np.column_stack([R[:, columns], c]))
+    factor[: top.shape[0]] = top
+    _, _, rank, null, _ = solve_triangular_system(factor, count, tolerance)
+    if rank == count:
+        return rank, [], ""
+    free = np.abs(null).max(axis=1) > IDENTIFIABLE_TOLERANCE
+    return rank, [names[j] for j in np.flatnonzero(free)], _rank_message(rank, count, null, names)
 
 
 def _compressed(
