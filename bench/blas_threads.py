@@ -24,14 +24,14 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--runs", type=int, default=15)
     args = parser.parse_args()
-    bp = sys.modules["dynid.base_parameters"]  # the attribute dynid.base_parameters is the function
+    bp = sys.modules["dynid.model.base_parameters"]
     robot = dynid.models.kuka_lwr4()
     base = dynid.base_parameters(robot, "torque", rotor=True, friction=True)
     rng = np.random.default_rng(0)
     q, qd, qdd = (rng.normal(size=(20_000, 7)) for _ in range(3))
     Y = robot.regressor(q, qd, qdd, rotor=True, friction=True, columns=base.independent)
     tau = robot.rnea(q, qd, qdd) + rng.normal(size=q.shape)
-    import dynid.identify as identify
+    import dynid.identification.identify as identify
 
     cases = {
         "base_parameters": (

@@ -19,7 +19,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 import dynid
-from dynid.identify import stack_by_joint
+from dynid.identification.identify import stack_by_joint
 
 
 def stacked_system(samples: int) -> tuple[np.ndarray, np.ndarray]:

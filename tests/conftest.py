@@ -126,7 +126,7 @@ def random_state(rng: np.random.Generator, arm_or_types: Arm | str, count: int |
 
 def lwr_model():
     """dynid.models.kuka_lwr4() (the contract's model)."""
-    import dynid.models
+    import dynid.model.models
 
     return dynid.models.kuka_lwr4()
 

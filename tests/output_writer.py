@@ -1,4 +1,4 @@
-"""A run that writes a result folder through ``dynid.io.output_folder.output_folder``, as every
+"""A run that writes a result folder through ``dynid.export.output_folder.output_folder``, as every
 dynid command does, for the tests of racing and killed runs (test_output_folder.py):
 
     python output_writer.py TARGET LABEL --signals DIR [--overwrite] [--wait PATH ...] [--hold]
@@ -17,7 +17,7 @@ import sys
 import time
 from pathlib import Path
 
-from dynid.io.output_folder import output_folder
+from dynid.export.output_folder import output_folder
 
 #: How long a wait may last before the run gives up (exit 3): far beyond the tests' needs.
 TIMEOUT = 30.0

@@ -25,7 +25,7 @@ import pytest
 
 import dynid
 from conftest import SEED, make_arm, random_pose, random_state
-from dynid.base_parameters import CACHE_SIZE
+from dynid.model.base_parameters import CACHE_SIZE
 
 RTOL = 1e-9
 FRESH_SEED = SEED + 1000  # the library draws its samples from seed 0 with its own sampler

@@ -39,7 +39,7 @@ def test_decorated_function_runs_capped_and_returns_its_value() -> None:
 
 def test_entry_points_are_capped(monkeypatch) -> None:
     # base_parameters, least_squares and the streaming solver see one BLAS thread inside.
-    import dynid._qr as qr
+    import dynid.identification._qr as qr
 
     seen: list[set[int]] = []
     original = qr.upper_triangle

@@ -12,7 +12,7 @@ import pytest
 import scipy.optimize
 
 import dynid
-from dynid.bounds import dynamic_bounds
+from dynid.model.bounds import dynamic_bounds
 
 G0 = 9.81
 L1, L2, LC1, LC2, M1, M2, I1, I2 = 1.0, 0.8, 0.45, 0.35, 3.0, 2.0, 0.25, 0.11

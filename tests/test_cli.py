@@ -12,9 +12,9 @@ import pytest
 
 import dynid
 from dynid.cli import main
+from dynid.export.result_files import load_result
 from dynid.io import save_log
-from dynid.io.model_files import save_model
-from dynid.io.result_files import load_result
+from dynid.model.model_files import save_model
 from test_log_identification import PNG, fourier_log
 
 

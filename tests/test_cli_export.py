@@ -88,7 +88,7 @@ def test_prior_only_with_physical(tmp_path, capsys) -> None:
 
 def test_residual_command(tmp_path, capsys) -> None:
     """`dynid residual` writes the residual of residual_from_log (the same numbers) and a plot."""
-    from dynid.observer import residual_from_log
+    from dynid.identification.observer import residual_from_log
 
     out = tmp_path / "residual"
     status = dynid.cli.main(

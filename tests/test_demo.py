@@ -15,8 +15,8 @@ import pytest
 
 import dynid
 import dynid.cli
-from dynid.demo import LINK_FRICTION, TIP_MASS, controller_model, run_demo
-from dynid.io.output_folder import MARKER
+from dynid.cli.demo import LINK_FRICTION, TIP_MASS, controller_model, run_demo
+from dynid.export.output_folder import MARKER
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 PLOTS = ("fig3_joint_motion.png", "fig4_torques.png", "fig6_g2_M11.png")

@@ -1,4 +1,4 @@
-"""identify_drive_gains (dynid.drive_gains): drive gains and base parameters from motor currents.
+"""identify_drive_gains (dynid.identification.drive_gains): drive gains and base parameters from motor currents.
 
 The runs are exact: currents i = tau / k_true with tau from Pinocchio's RNEA of the KUKA LWR-IV
 model written as URDF (plus dynid's rotor inertia and friction terms, which URDF does not carry
@@ -18,11 +18,11 @@ import pytest
 
 import dynid
 from dynid.cli import main
-from dynid.drive_gains import identify_drive_gains, torques_from_currents
-from dynid.identify import RankDeficientError
+from dynid.export.result_files import load_result, save_result
+from dynid.identification.drive_gains import identify_drive_gains, torques_from_currents
+from dynid.identification.identify import RankDeficientError
+from dynid.identification.payload_files import load_payload
 from dynid.io import Log, save_log
-from dynid.io.payload_files import load_payload
-from dynid.io.result_files import load_result, save_result
 from reference_model import physical_to_params
 from test_log_identification import fourier_log
 
@@ -310,7 +310,7 @@ def test_saved_result_keeps_the_gains_and_validates_a_current_log(lwr, runs, tmp
 
 def test_a_point_mass_payload_is_its_standard_parameters():
     """mass and com without inertia: a point mass (Steiner in the tests' reference model)."""
-    from dynid.drive_gain_system import payload_vector
+    from dynid.identification.drive_gain_system import payload_vector
 
     known, estimated = payload_vector({"mass": 2.0, "com": COM}, None)
     np.testing.assert_allclose(

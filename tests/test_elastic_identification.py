@@ -23,7 +23,7 @@ import pytest
 
 import dynid
 from conftest import make_arm
-from dynid.elastic_identification import identify_motor_side, identify_stiffness
+from dynid.identification.elastic_identification import identify_motor_side, identify_stiffness
 
 FS = 1000.0
 DURATION = 8.0

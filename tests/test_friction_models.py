@@ -20,17 +20,17 @@ import pytest
 
 import dynid
 from dynid.cli import main
-from dynid.friction_models import (
+from dynid.export.result_files import load_result, result_from_dict, result_to_dict, save_result
+from dynid.identification.friction_models import (
     asymmetric_columns,
     asymmetric_count,
     asymmetric_names,
     friction_model,
 )
+from dynid.identification.log_identification import identify_log, validate_log
+from dynid.identification.observer import residual_from_log, robot_from_identification
 from dynid.io import Log, save_log
-from dynid.io.model_files import save_model
-from dynid.io.result_files import load_result, result_from_dict, result_to_dict, save_result
-from dynid.log_identification import identify_log, validate_log
-from dynid.observer import residual_from_log, robot_from_identification
+from dynid.model.model_files import save_model
 from test_log_identification import fourier_log
 
 N = 7

@@ -1,4 +1,4 @@
-"""The paper's identification from the controller's numeric M(q) and g(q) (dynid.from_controller).
+"""The paper's identification from the controller's numeric M(q) and g(q) (dynid.identification.from_controller).
 
 Gaz, Flacco, De Luca, ICRA 2014, Sect. V (eqs. (17)-(26)) and Sect. VI (joint 1's gravity row
 dropped, the identically zero element M_76, eq. (27), the symbolic gravity coefficients (28)).
@@ -15,7 +15,7 @@ import pytest
 
 import dynid
 import reference_model as ref
-from dynid.demo import controller_model
+from dynid.cli.demo import controller_model
 from dynid.sim import VirtualController
 
 D1, D2 = 0.4, 0.39  # the LWR's d_3 and d_5 (paper Table I)

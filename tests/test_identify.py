@@ -1,4 +1,4 @@
-"""Least-squares identification (dynid.identify) against independent computations.
+"""Least-squares identification (dynid.identification.identify) against independent computations.
 
 Lecture, Robotics 2 "Least Squares (LS) identification" (p. 27) and "Additional remarks on LS
 identification" (p. 28). The data come from the real LWR-IV regressor (noise added with known
@@ -13,7 +13,12 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.identify import LeastSquaresResult, RankDeficientError, least_squares, stack_by_joint
+from dynid.identification.identify import (
+    LeastSquaresResult,
+    RankDeficientError,
+    least_squares,
+    stack_by_joint,
+)
 
 
 @pytest.fixture(scope="module")

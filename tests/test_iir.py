@@ -11,8 +11,8 @@ import pytest
 from scipy import signal as sp
 
 from dynid import _core
-from dynid import signal as sig
-from dynid._iir import butterworth_lowpass, steady_state
+from dynid.logs import signal as sig
+from dynid.logs._iir import butterworth_lowpass, steady_state
 
 ORDERS = range(1, 9)
 CUTOFFS = (0.01, 0.05, 0.2, 0.5, 0.9)  # times the Nyquist frequency
@@ -116,7 +116,7 @@ def test_import_dynid_signal_does_not_import_scipy_signal() -> None:
     """The reason for dynid._iir: filtering without scipy.signal's 0.5 s import (its time is
     measured in bench/import_time.py, never here). spike_mask still imports it when called."""
     code = (
-        "import sys, numpy as np, dynid.signal as s; "
+        "import sys, numpy as np, dynid.logs.signal as s; "
         "s.lowpass(np.arange(100.0), 100.0, 5.0); s.decimate(np.arange(100.0), 2); "
         "print('scipy.signal' in sys.modules, 'scipy.ndimage' in sys.modules)"
     )

@@ -22,12 +22,12 @@ import pytest
 
 import dynid
 import dynid.cli
-import dynid.demo
+import dynid.cli.demo
 from dynid import excitation, signal
-from dynid.from_controller import identify_from_controller, payload_mass_estimates
-from dynid.identify import RankDeficientError, least_squares, stack_by_joint
+from dynid.identification.from_controller import identify_from_controller, payload_mass_estimates
+from dynid.identification.identify import RankDeficientError, least_squares, stack_by_joint
+from dynid.identification.validation import error_metrics
 from dynid.io import Log, prepare_log
-from dynid.validation import error_metrics
 
 RNG = np.random.default_rng(2024)
 T, N, P = 40, 2, 3
@@ -294,13 +294,13 @@ def test_demo_with_too_few_configurations_exits_2_with_one_line(tmp_path, capsys
 
 
 def test_demo_minimum_sizes_are_checked_by_one_function():
-    assert dynid.demo.check_demo_sizes(3, 1) == (3, 1)
+    assert dynid.cli.demo.check_demo_sizes(3, 1) == (3, 1)
     with pytest.raises(ValueError, match=r"^train: expected an integer >= 3"):
-        dynid.demo.check_demo_sizes(2, 1)
+        dynid.cli.demo.check_demo_sizes(2, 1)
     with pytest.raises(ValueError, match=r"^validation: expected an integer >= 1"):
-        dynid.demo.check_demo_sizes(3, 0)
+        dynid.cli.demo.check_demo_sizes(3, 0)
     with pytest.raises(ValueError, match=r"^train: "):
-        dynid.demo.check_demo_sizes(True, 1)
+        dynid.cli.demo.check_demo_sizes(True, 1)
 
 
 # --------------------------------------------------------------------------- the helper itself

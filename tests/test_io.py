@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy import signal as sp
 
-from dynid import signal as sig
 from dynid.io import Log, load_log, prepare_log, save_log
+from dynid.logs import signal as sig
 
 DATA = Path(__file__).parent / "data"
 FS = 200.0

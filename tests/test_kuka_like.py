@@ -24,8 +24,9 @@ import pytest
 import scipy.optimize
 
 import dynid
-from dynid.demo import controller_model, torque_validation
-from dynid.from_controller import identify_from_controller
+from dynid.cli.demo import controller_model, torque_validation
+from dynid.identification.from_controller import identify_from_controller
+from dynid.identification.validation import error_metrics
 from dynid.sim import (
     KukaLike,
     MotorPD,
@@ -33,7 +34,6 @@ from dynid.sim import (
     paper_validation_trajectory,
     simulate_elastic,
 )
-from dynid.validation import error_metrics
 
 Q_D = np.array([0.3, 0.8, -0.2, -1.0, 0.4, 0.6, 0.1])
 #: Joint stiffness assumed for the LWR-IV [N m/rad]: stiffer shoulder and elbow, softer wrist.

@@ -18,8 +18,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 import dynid
-from dynid import identify
-from dynid.identify import RankDeficientError, stack_by_joint
+from dynid.identification import identify
+from dynid.identification.identify import RankDeficientError, stack_by_joint
 
 RTOL = 1e-9
 

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.link_frames import express_in_frames_of, link_frames
-from dynid.physical import physical_least_squares
+from dynid.identification.physical import physical_least_squares
+from dynid.model.link_frames import express_in_frames_of, link_frames
 
 DATA = Path(__file__).parent / "data"
 PRIOR = Path(__file__).parent.parent / "examples" / "kuka_lwr4_urdf_prior.json"

@@ -1,4 +1,4 @@
-"""identify_log / validate_log / save and load (dynid.log_identification, dynid.result_files).
+"""identify_log / validate_log / save and load (dynid.identification.log_identification, dynid.export.result_files).
 
 The synthetic logs are exact: torques from the robot's RNEA (rigid body, rotor inertia, viscous
 and Coulomb friction), positions, velocities and accelerations from a Fourier series in closed
@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.identify import RankDeficientError
+from dynid.export.result_files import load_result, save_result
+from dynid.identification.identify import RankDeficientError
+from dynid.identification.log_identification import identify_log, validate_log
 from dynid.io import Log
-from dynid.io.result_files import load_result, save_result
-from dynid.log_identification import identify_log, validate_log
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

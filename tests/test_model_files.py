@@ -1,4 +1,4 @@
-"""Model files (dynid.io.model_files): round trips, the LWR4+ tables against pinocchio, errors."""
+"""Model files (dynid.model.model_files): round trips, the LWR4+ tables against pinocchio, errors."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.io.model_files import BUILTIN_MODELS, load_model, model_from_dict, save_model
+from dynid.model.model_files import BUILTIN_MODELS, load_model, model_from_dict, save_model
 
 DATA = Path(__file__).parent / "data"
 EXAMPLES = Path(__file__).parent.parent / "examples"

@@ -139,7 +139,7 @@ def test_info_prints_rounding_residue_as_zero_and_keeps_real_small_values():
     """`dynid info` on the UR5 read from its URDF printed alpha = -6.12323e-17 (-3.508e-15°) and a
     product of inertia of 1.704e-100 (issue 22). Residue below 1e-9 of its scale reads 0 (never
     -0); a value that is small but real (a light link's inertia) is printed as it is."""
-    from dynid.summary import model_summary
+    from dynid.export.summary import model_summary
 
     robot = dynid.models.ur5()
     assert np.abs(robot.dh[:, 1] % (np.pi / 2)).min() < 1e-15  # the residue is there...

@@ -224,10 +224,10 @@ def test_bad_input_raises_value_error_naming_argument(call, name):
 
 
 def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property, tmp_path):
+    from dynid.export.result_files import load_result, save_result
+    from dynid.identification.log_identification import identify_log
+    from dynid.identification.observer import residual_from_log, robot_from_identification
     from dynid.io import load_log
-    from dynid.io.result_files import load_result, save_result
-    from dynid.log_identification import identify_log
-    from dynid.observer import residual_from_log, robot_from_identification
 
     data = REPO / "tests" / "data"
     train = load_log(data / "measurements_1.npz", skip=500)
@@ -260,8 +260,8 @@ def test_real_lwr_logs_residual_is_the_filtered_model_error(record_property, tmp
 
 
 def test_residual_files_and_plot(tmp_path, contact_run):
+    from dynid.identification.observer import plot_residual, residual_from_log, save_residual
     from dynid.io import Log
-    from dynid.observer import plot_residual, residual_from_log, save_residual
 
     robot, t, q, qd, tau, _ = contact_run
     log = Log(t=t, q=q, qd=qd, tau=tau)
@@ -284,8 +284,8 @@ def test_residual_rms_of_huge_and_tiny_torques_is_finite_and_exact(contact_run, 
     """Issue 22: rms = sqrt(mean(r**2)) was inf for |r| beyond ~1e154 (and 0 below ~1e-162).
     A robot and torques scaled by a power of two give a residual scaled by it exactly, and its
     RMS must be the unscaled RMS times that power."""
+    from dynid.identification.observer import residual_from_log
     from dynid.io import Log
-    from dynid.observer import residual_from_log
 
     robot, t, q, qd, tau, _ = contact_run
     plain = residual_from_log(robot, Log(t=t, q=q, qd=qd, tau=tau), 50.0)

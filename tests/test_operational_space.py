@@ -94,7 +94,7 @@ def test_operational_space_equation_matches_forward_dynamics(robot_name, rows):
             arm = make_arm("lwr" if robot_name == "lwr" else "random_prismatic_first")
             robot, types = arm.robot(), arm.joint_types
         states = [random_state(rng, types)[:2] for _ in range(3)]
-    selected = dynid.operational_space.task_rows(rows)
+    selected = dynid.model.operational_space.task_rows(rows)
     for q, qd in states:
         F = rng.normal(size=len(selected)) * 10
         tau = robot.jacobian(q)[selected].T @ F + robot.friction(qd)

@@ -21,8 +21,8 @@ import pytest
 
 import dynid
 from dynid.cli import main
+from dynid.export.output_folder import check_output_path, output_folder
 from dynid.io import save_log
-from dynid.io.output_folder import check_output_path, output_folder
 from output_writer import content
 from test_log_identification import fourier_log
 
@@ -262,7 +262,7 @@ def test_results_are_synced_before_they_are_moved_into_place(tmp_path: Path, mon
 def test_overwrite_without_rename_exchange(tmp_path: Path, monkeypatch) -> None:
     """Where renameat2 RENAME_EXCHANGE is missing (C library, kernel or file system), the old
     folder is renamed aside and the new one moved in: the same result, no debris."""
-    import dynid.io.output_folder as module
+    import dynid.export.output_folder as module
 
     def missing(a: Path, b: Path) -> None:
         raise OSError(errno.ENOSYS, "renameat2: not in this C library")

@@ -20,7 +20,7 @@ import pytest
 
 import dynid
 import reference_model as ref
-from dynid.demo import TIP_COM, TIP_INERTIA, TIP_MASS, controller_model
+from dynid.cli.demo import TIP_COM, TIP_INERTIA, TIP_MASS, controller_model
 from dynid.sim import VirtualController
 
 DEMO_NOISE = {"model_noise": 1e-5, "torque_noise": 0.05, "position_noise": 1e-5}  # run_demo's

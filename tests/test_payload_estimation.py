@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.demo import TIP_COM, TIP_INERTIA, TIP_MASS, controller_model
-from dynid.payload import PAYLOAD_NAMES, estimate_payload, physical_from_parameters
+from dynid.cli.demo import TIP_COM, TIP_INERTIA, TIP_MASS, controller_model
+from dynid.identification.payload import PAYLOAD_NAMES, estimate_payload, physical_from_parameters
 from dynid.sim import VirtualController
 
 EXACT = 1e-9  # noise-free data: the fit is exact up to rounding (observed ~1e-15)

@@ -19,12 +19,16 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.identify import least_squares
+from dynid.identification.identify import least_squares
+from dynid.identification.log_identification import identify_log
+from dynid.identification.physical import PhysicalIdentificationError, physical_least_squares
 from dynid.io import Log
-from dynid.io.model_files import save_model
-from dynid.log_identification import identify_log
-from dynid.physical import PhysicalIdentificationError, physical_least_squares
-from dynid.pseudo_inertia import nearest_with_margin, pseudo_inertia, standard_from_pseudo_inertia
+from dynid.model.model_files import save_model
+from dynid.model.pseudo_inertia import (
+    nearest_with_margin,
+    pseudo_inertia,
+    standard_from_pseudo_inertia,
+)
 
 T = 300  # random states, 2100 stacked rows for 7 x 10 + 21 = 91 standard parameters
 

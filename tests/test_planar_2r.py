@@ -33,7 +33,7 @@ def build_from_dh(gravity: tuple[float, float, float] = (0.0, -G0, 0.0)) -> dyni
 
 
 def build_from_models(gravity: tuple[float, float, float] = (0.0, -G0, 0.0)) -> dynid.Robot:
-    from dynid import models
+    from dynid.model import models
 
     return models.planar_2r(
         l1=L1, l2=L2, lc1=LC1, lc2=LC2, m1=M1, m2=M2, I1=I1, I2=I2, gravity=gravity

@@ -1,4 +1,4 @@
-"""dynid.plots.envelope (the min/max decimation of long signals before drawing) against a
+"""dynid.export.plots.envelope (the min/max decimation of long signals before drawing) against a
 bucket-by-bucket loop, and the plots of a long log."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dynid.plots import MAX_POINTS, envelope, plot_torques
+from dynid.export.plots import MAX_POINTS, envelope, plot_torques
 
 
 @pytest.mark.parametrize("T", [1, 10, MAX_POINTS, MAX_POINTS + 1, 3 * MAX_POINTS - 1, 100_003])

@@ -12,10 +12,14 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.export.result_files import load_result, save_result
+from dynid.identification.log_identification import identify_log
+from dynid.identification.position_torque import (
+    position_columns,
+    position_names,
+    position_torque_joints,
+)
 from dynid.io import Log
-from dynid.io.result_files import load_result, save_result
-from dynid.log_identification import identify_log
-from dynid.position_torque import position_columns, position_names, position_torque_joints
 from test_log_identification import fourier_log
 
 KS = np.array([0.3, 0.0, -0.2, 0.5, 0.1, -0.4, 0.35])

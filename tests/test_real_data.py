@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.identification.log_identification import identify_log, validate_log
 from dynid.io import Log, load_log
-from dynid.io.model_files import load_model
-from dynid.log_identification import identify_log, validate_log
+from dynid.model.model_files import load_model
 
 DATA = Path(__file__).parent / "data"
 EXAMPLES = Path(__file__).parent.parent / "examples"

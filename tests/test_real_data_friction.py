@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.log_identification import identify_log, validate_log
+from dynid.identification.log_identification import identify_log, validate_log
 from real_logs import lwr4_logs
 
 PRIOR = Path(__file__).parent.parent / "examples" / "kuka_lwr4_urdf_prior.json"

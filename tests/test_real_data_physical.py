@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.log_identification import DEFAULT_PRIOR_WEIGHT, identify_log, validate_log
+from dynid.identification.log_identification import DEFAULT_PRIOR_WEIGHT, identify_log, validate_log
 from real_logs import DATA, lwr4_logs
 
 PRIOR = Path(__file__).parent.parent / "examples" / "kuka_lwr4_urdf_prior.json"

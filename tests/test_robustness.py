@@ -11,9 +11,9 @@ import pytest
 import dynid
 import dynid.cli
 from dynid import excitation, io, signal
-from dynid.io.output_folder import MARKER, output_folder, write_text_atomic
-from dynid.io.result_files import load_result, save_result
-from dynid.log_identification import identify_log
+from dynid.export.output_folder import MARKER, output_folder, write_text_atomic
+from dynid.export.result_files import load_result, save_result
+from dynid.identification.log_identification import identify_log
 
 # --------------------------------------------------------------------------- item 6
 
@@ -353,7 +353,7 @@ def test_foreign_log_columns_and_time_unit(tmp_path) -> None:
         io.load_log(csv_path, columns={"t": "stamp", "q": "joint_*", "tau": "effort_*"})
     with pytest.raises(ValueError, match=r"^time_unit: "):
         io.load_log(csv_path, columns=mapping, time_unit="hours")
-    from dynid.io.columns import parse_columns
+    from dynid.logs.columns import parse_columns
 
     assert parse_columns("t=stamp, q=pos_*,tau=effort_*") == mapping
     with pytest.raises(ValueError, match=r"^columns: unknown signal 'x'"):
@@ -414,7 +414,7 @@ def test_import_dynid_loads_no_plotting_or_optimisers() -> None:
 def test_load_model_reads_builtin_names_and_urdf() -> None:
     """The CLI's --model: the new built-in names and a URDF path give the models of
     dynid.models / Robot.from_urdf (exact: the same construction)."""
-    from dynid.io.model_files import load_model
+    from dynid.model.model_files import load_model
 
     assert load_model("panda") == dynid.models.panda()
     assert load_model("ur5") == dynid.models.ur5()

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import signal as sp
 
-from dynid import signal as sig
+from dynid.logs import signal as sig
 
 FS = 200.0  # Hz, the rate of the KUKA LWR4+ logs
 

@@ -16,8 +16,8 @@ import pytest
 
 import dynid
 import reference_model as ref
-from dynid.demo import controller_model
-from dynid.signal import differentiate, lowpass
+from dynid.cli.demo import controller_model
+from dynid.logs.signal import differentiate, lowpass
 from dynid.sim import VirtualController, paper_validation_trajectory, plant_friction
 from dynid.sim.virtual_controller import COULOMB_BAND, stable_substeps
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.time_scaling import scale_motion, scale_time, scale_torques
+from dynid.motion.time_scaling import scale_motion, scale_time, scale_torques
 
 TOL = 1e-12  # relative to the largest torque: the scaling is exact, only rounding differs
 
@@ -189,7 +189,7 @@ def test_scaling_for_torque_limits_reaches_the_limit_exactly(drives):
     # Independent check by brute force on scale_torques' output (itself checked against rnea
     # above): at the returned k the largest |tau| / tau_max is 1 (1e-10), a 1e-6 faster motion
     # violates it, and every slower one on a grid up to 100 k respects it.
-    from dynid.time_scaling import scaling_for_torque_limits
+    from dynid.motion.time_scaling import scaling_for_torque_limits
 
     robot = dynid.models.kuka_lwr4()
     if drives == "rigid_body":
@@ -214,7 +214,7 @@ def test_scaling_for_torque_limits_on_the_notes_example_and_bad_limits():
     # closed form per sample: k^2 = max (tau - g) / (+-limit - g) over the samples where the
     # limit is approached. With a 10 N m limit on joint 1 (and a loose one on joint 2) this is
     # checked against that formula (1e-12); a limit below the final gravity torque is refused.
-    from dynid.time_scaling import scaling_for_torque_limits
+    from dynid.motion.time_scaling import scaling_for_torque_limits
 
     robot = dynid.models.planar_2r(m1=0.26, m2=0.26)
     t = np.linspace(0.0, 0.5, 501)

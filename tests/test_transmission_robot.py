@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import dynid
+import dynid.model.model_files
 from coupled_robots import T_WRIST, coupled_puma
-from dynid.io.model_files import load_model, model_to_dict, save_model
+from dynid.model.model_files import load_model, model_to_dict, save_model
 
 
 def test_default_is_the_identity_and_read_only() -> None:
@@ -40,7 +41,7 @@ def test_copy_pickle_and_equality_include_the_transmission() -> None:
     # A robot pickled before the transmission existed (no key in its state) is decoupled.
     state = plain._state()
     del state["transmission"]
-    restored = dynid.robot._robot_from_state(state)
+    restored = dynid.model.robot._robot_from_state(state)
     assert restored == plain
 
 
@@ -55,7 +56,7 @@ def test_model_file_round_trip(tmp_path) -> None:
     data = model_to_dict(robot)
     data["transmission"] = [[1.0, 0.0], [0.0, 1.0]]
     with pytest.raises(ValueError, match="transmission"):
-        dynid.io.model_files.model_from_dict(data)
+        dynid.model.model_files.model_from_dict(data)
 
 
 def test_to_urdf_refuses_coupled_drives_and_rigid_body_drops_them() -> None:
@@ -75,7 +76,7 @@ def test_to_urdf_refuses_coupled_drives_and_rigid_body_drops_them() -> None:
 
 
 def test_model_summary_shows_a_coupled_transmission() -> None:
-    from dynid.summary import model_summary
+    from dynid.export.summary import model_summary
 
     assert "transmission" not in model_summary(dynid.models.puma560())
     text = model_summary(coupled_puma())
@@ -91,7 +92,7 @@ def test_with_payload_keeps_the_transmission() -> None:
 def test_time_scaling_of_coupled_torques_is_rnea_of_the_scaled_motion() -> None:
     """scale_torques(k) of a coupled robot's torques equals rnea at (q, qd / k, qdd / k^2): the
     motor friction T^T Fv T qd scales as 1/k and T^T Fs sign(T qd) not at all (1e-12)."""
-    from dynid import time_scaling
+    from dynid.motion import time_scaling
 
     robot = coupled_puma()
     rng = np.random.default_rng(3)

@@ -18,8 +18,8 @@ import pinocchio as pin
 import pytest
 
 import dynid
-from dynid.urdf.reading import standard_parameters
-from dynid.urdf.tree import read_tree
+from dynid.model.urdf.reading import standard_parameters
+from dynid.model.urdf.tree import read_tree
 from pinocchio_urdf import (
     DATA,
     assert_matches_pinocchio,

@@ -203,7 +203,7 @@ def with_link2(body: str, pad: str | None = None, extra: str = "") -> str:
 def test_a_body_that_to_urdf_refuses_is_refused_by_name(
     body: str, pad: str | None, reason: str
 ) -> None:
-    """One rule (dynid.urdf.consistency) on both sides: the body from_urdf refuses (naming its
+    """One rule (dynid.model.urdf.consistency) on both sides: the body from_urdf refuses (naming its
     link and joint, and the links merged into it) is the link to_urdf refuses, for the same
     reason; check_physical=False reads the file as it is."""
     text = with_link2(body, pad)

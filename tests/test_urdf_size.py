@@ -1,7 +1,8 @@
 """Robot.from_urdf on large files (issue 22.9): reading is linear in the size of the URDF, and a
 chain of more joints than a model file may hold is refused before any work on it.
 
-Time is measured by the number of Python lines executed inside ``dynid.urdf`` (``sys.settrace``):
+Time is measured by the number of Python lines executed inside ``dynid.model.urdf``
+(``sys.settrace``):
 unlike a clock it does not depend on the machine's load, so doubling the file must double it (a
 ratio of 2; 4 when every link scans every joint, as the reader did)."""
 
@@ -20,9 +21,9 @@ import pytest
 
 import dynid
 import dynid.cli
-import dynid.urdf
+import dynid.model.urdf
 from dynid._checks import MAX_JOINTS
-from dynid.io.model_files import load_model
+from dynid.model.model_files import load_model
 
 INERTIAL = (
     '<inertial><mass value="1"/>'
@@ -51,8 +52,8 @@ class TooMuchWork(Exception):
 
 
 def lines_executed(call: Callable[[], object], budget: int) -> int:
-    """The number of lines of ``dynid.urdf``'s modules that ``call()`` executes."""
-    folder = str(Path(dynid.urdf.__file__).parent)
+    """The number of lines of ``dynid.model.urdf``'s modules that ``call()`` executes."""
+    folder = str(Path(dynid.model.urdf.__file__).parent)
     count = 0
 
     def local(frame: FrameType, event: str, arg: Any) -> Any:

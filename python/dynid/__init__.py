@@ -2,19 +2,19 @@
 
 The C++ core (``dynid._core``) computes kinematics, inverse and forward dynamics, the inertia
 and Coriolis matrices and the regressors; this package holds the user's workflow on top of it,
-one way from the model to the files:
+one way from the model to the files, each step a subpackage that imports only the ones before it
+(docs/architecture.md):
 
-- the model: :mod:`~dynid.robot` (:class:`Robot`), :mod:`~dynid.models`, :mod:`dynid.urdf`
-  (``Robot.from_urdf`` / ``Robot.to_urdf``);
-- its linear parametrisation: :mod:`~dynid.base_parameters`;
-- data in: :mod:`dynid.io` (logs), :mod:`~dynid.signal`, :mod:`~dynid.sim` (closed-loop
-  simulation, a virtual robot);
-- identification: :mod:`~dynid.identify` (least squares), :mod:`~dynid.from_controller` (the
-  paper's method), :mod:`~dynid.log_identification`, :mod:`dynid.excitation`,
-  :mod:`~dynid.recursive`;
-- checking the result: :mod:`~dynid.validation`, :mod:`~dynid.plots`;
-- uses of the model: :mod:`~dynid.time_scaling`, :mod:`~dynid.bounds`, :mod:`~dynid.payload`;
-- files: :mod:`dynid.io` (model and result files); the command line: :mod:`dynid.cli`.
+- :mod:`dynid.model`: the robot (:class:`Robot`), ready-made arms (``dynid.models``), URDF in and
+  out, model files, elastic joints, the base parameters of its regressor;
+- :mod:`dynid.excitation` (exciting trajectories), :mod:`dynid.motion` (time scaling) and
+  :mod:`dynid.sim` (closed-loop simulation, a virtual robot): motions and data from a model;
+- :mod:`dynid.logs`: data in, the measurement logs and their preparation (``dynid.signal``);
+- :mod:`dynid.identification`: least squares, the physically consistent fit, a log's
+  identification, the paper's method, payloads, drive gains, validation (``dynid.validation``),
+  the momentum observer (``dynid.observer``);
+- :mod:`dynid.export`: files out (results, output folders, plots, summaries);
+- :mod:`dynid.cli`: the command line, and ``dynid demo``.
 
 Names are loaded on first use (PEP 562), so ``import dynid`` stays fast: SciPy's optimisers and
 signal processing and matplotlib are imported only by the functions that need them.
@@ -30,85 +30,94 @@ from ._version import __version__
 
 # Imported here, not lazily: the submodule of the same name would otherwise shadow the function
 # as soon as anything imports it.
-from .base_parameters import BaseParameters, base_parameters
-from .robot import Robot
+from .model.base_parameters import BaseParameters, base_parameters
+from .model.robot import Robot
 
 if TYPE_CHECKING:
-    from . import models
-    from .bounds import DynamicBounds, dynamic_bounds
     from .cmake import get_cmake_dir, get_include
-    from .drive_gains import DriveGainIdentification, identify_drive_gains
-    from .elastic import ElasticRobot
-    from .elastic_identification import DriveIdentification, identify_drives
     from .errors import PhysicalIdentificationError
     from .excitation import FourierTrajectory, optimize_excitation
-    from .from_controller import IdentifiedModel, identify_from_controller, payload_mass_estimates
-    from .identify import LeastSquaresResult, RankDeficientError, least_squares
-    from .io.log_files import Log, load_log, save_log
-    from .io.model_files import load_model, save_model
-    from .io.preparation import prepare_log
-    from .io.result_files import load_result, save_result
-    from .log_identification import LogIdentification, identify_log, validate_log
-    from .payload import PayloadEstimate, estimate_payload, payload_from_identified
-    from .physical import PhysicalResult, physical_least_squares
-    from .recursive import RecursiveLeastSquares
+    from .export.result_files import load_result, save_result
+    from .identification.drive_gains import DriveGainIdentification, identify_drive_gains
+    from .identification.elastic_identification import DriveIdentification, identify_drives
+    from .identification.from_controller import (
+        IdentifiedModel,
+        identify_from_controller,
+        payload_mass_estimates,
+    )
+    from .identification.identify import LeastSquaresResult, RankDeficientError, least_squares
+    from .identification.log_identification import LogIdentification, identify_log, validate_log
+    from .identification.payload import PayloadEstimate, estimate_payload, payload_from_identified
+    from .identification.physical import PhysicalResult, physical_least_squares
+    from .identification.recursive import RecursiveLeastSquares
+    from .identification.streaming import LeastSquaresAccumulator, least_squares_streaming
+    from .logs.log_files import Log, load_log, save_log
+    from .logs.preparation import prepare_log
+    from .model import models
+    from .model.bounds import DynamicBounds, dynamic_bounds
+    from .model.elastic import ElasticRobot
+    from .model.model_files import load_model, save_model
+    from .motion.time_scaling import (
+        scale_motion,
+        scale_time,
+        scale_torques,
+        scaling_for_torque_limits,
+    )
     from .sim import VirtualController, simulate
-    from .streaming import LeastSquaresAccumulator, least_squares_streaming
-    from .time_scaling import scale_motion, scale_time, scale_torques, scaling_for_torque_limits
 
 #: Public name -> the module that defines it (imported on first access).
 _LAZY = {
-    "models": ".models",
+    "models": ".model.models",
     "io": ".io",
     "excitation": ".excitation",
-    "signal": ".signal",
+    "signal": ".logs.signal",
     "sim": ".sim",
-    "validation": ".validation",
+    "validation": ".identification.validation",
     "get_cmake_dir": ".cmake",
     "get_include": ".cmake",
     "FourierTrajectory": ".excitation",
     "optimize_excitation": ".excitation",
-    "IdentifiedModel": ".from_controller",
-    "identify_from_controller": ".from_controller",
-    "payload_mass_estimates": ".from_controller",
-    "LeastSquaresResult": ".identify",
-    "RankDeficientError": ".identify",
-    "least_squares": ".identify",
-    "LeastSquaresAccumulator": ".streaming",
-    "least_squares_streaming": ".streaming",
-    "Log": ".io.log_files",
-    "load_log": ".io.log_files",
-    "save_log": ".io.log_files",
-    "prepare_log": ".io.preparation",
-    "load_model": ".io.model_files",
-    "save_model": ".io.model_files",
-    "load_result": ".io.result_files",
-    "save_result": ".io.result_files",
-    "LogIdentification": ".log_identification",
-    "identify_log": ".log_identification",
-    "validate_log": ".log_identification",
+    "IdentifiedModel": ".identification.from_controller",
+    "identify_from_controller": ".identification.from_controller",
+    "payload_mass_estimates": ".identification.from_controller",
+    "LeastSquaresResult": ".identification.identify",
+    "RankDeficientError": ".identification.identify",
+    "least_squares": ".identification.identify",
+    "LeastSquaresAccumulator": ".identification.streaming",
+    "least_squares_streaming": ".identification.streaming",
+    "Log": ".logs.log_files",
+    "load_log": ".logs.log_files",
+    "save_log": ".logs.log_files",
+    "prepare_log": ".logs.preparation",
+    "load_model": ".model.model_files",
+    "save_model": ".model.model_files",
+    "load_result": ".export.result_files",
+    "save_result": ".export.result_files",
+    "LogIdentification": ".identification.log_identification",
+    "identify_log": ".identification.log_identification",
+    "validate_log": ".identification.log_identification",
     "PhysicalIdentificationError": ".errors",
-    "PhysicalResult": ".physical",
-    "physical_least_squares": ".physical",
-    "RecursiveLeastSquares": ".recursive",
+    "PhysicalResult": ".identification.physical",
+    "physical_least_squares": ".identification.physical",
+    "RecursiveLeastSquares": ".identification.recursive",
     "VirtualController": ".sim",
     "simulate": ".sim",
-    "DynamicBounds": ".bounds",
-    "ElasticRobot": ".elastic",
-    "elastic": ".elastic",
-    "DriveGainIdentification": ".drive_gains",
-    "identify_drive_gains": ".drive_gains",
-    "DriveIdentification": ".elastic_identification",
-    "identify_drives": ".elastic_identification",
-    "dynamic_bounds": ".bounds",
-    "PayloadEstimate": ".payload",
-    "estimate_payload": ".payload",
-    "payload_from_identified": ".payload",
-    "scale_time": ".time_scaling",
-    "scale_motion": ".time_scaling",
-    "scale_torques": ".time_scaling",
-    "scaling_for_torque_limits": ".time_scaling",
-    "observer": ".observer",
+    "DynamicBounds": ".model.bounds",
+    "ElasticRobot": ".model.elastic",
+    "elastic": ".model.elastic",
+    "DriveGainIdentification": ".identification.drive_gains",
+    "identify_drive_gains": ".identification.drive_gains",
+    "DriveIdentification": ".identification.elastic_identification",
+    "identify_drives": ".identification.elastic_identification",
+    "dynamic_bounds": ".model.bounds",
+    "PayloadEstimate": ".identification.payload",
+    "estimate_payload": ".identification.payload",
+    "payload_from_identified": ".identification.payload",
+    "scale_time": ".motion.time_scaling",
+    "scale_motion": ".motion.time_scaling",
+    "scale_torques": ".motion.time_scaling",
+    "scaling_for_torque_limits": ".motion.time_scaling",
+    "observer": ".identification.observer",
 }
 
 # Literal (not computed) so that linters and type checkers see the public names; a test checks
@@ -180,7 +189,7 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'dynid' has no attribute {name!r}")
     value = importlib.import_module(module, __name__)
-    if name != module.lstrip("."):
+    if name != module.rsplit(".", 1)[-1]:  # a name defined in the module, not the module
         value = getattr(value, name)
     globals()[name] = value  # later accesses skip this function
     return value

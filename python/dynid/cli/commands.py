@@ -21,7 +21,7 @@ def _steps(total: int) -> Callable[[str], None]:
 
 def log_options(args: argparse.Namespace) -> dict[str, Any]:
     """The ``load_log`` options given on the command line."""
-    from ..io.columns import parse_columns
+    from ..logs.columns import parse_columns
 
     columns = parse_columns(args.columns) if args.columns is not None else None
     return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
@@ -39,7 +39,7 @@ def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def demo(args: argparse.Namespace) -> None:
-    from ..demo import run_demo
+    from .demo import run_demo
 
     run_demo(
         args.output,
@@ -51,11 +51,11 @@ def demo(args: argparse.Namespace) -> None:
 
 
 def identify(args: argparse.Namespace) -> None:
-    from ..io.log_files import load_log
-    from ..io.model_files import load_model
-    from ..io.output_folder import check_output_path
-    from ..io.result_files import save_result
-    from ..log_identification import identify_log
+    from ..export.output_folder import check_output_path
+    from ..export.result_files import save_result
+    from ..identification.log_identification import identify_log
+    from ..logs.log_files import load_log
+    from ..model.model_files import load_model
 
     check_output_path(args.output, args.overwrite, inputs=identify_inputs(args))  # before the work
     if args.current:
@@ -106,11 +106,11 @@ def identify_inputs(args: argparse.Namespace) -> list[str | None]:
 
 def identify_from_currents(args: argparse.Namespace) -> None:
     """``dynid identify --current``: drive gains and base parameters from motor currents."""
-    from ..drive_gains import identify_drive_gains
-    from ..io.log_files import load_log
-    from ..io.model_files import load_model
-    from ..io.payload_files import load_payload
-    from ..io.result_files import save_result
+    from ..export.result_files import save_result
+    from ..identification.drive_gains import identify_drive_gains
+    from ..identification.payload_files import load_payload
+    from ..logs.log_files import load_log
+    from ..model.model_files import load_model
 
     if args.physical or args.position_torque or args.prior is not None or args.asymmetric_friction:
         raise ValueError(
@@ -155,18 +155,18 @@ def identify_from_currents(args: argparse.Namespace) -> None:
 
 
 def validate(args: argparse.Namespace) -> None:
-    from ..io.log_files import load_log
-    from ..io.output_folder import check_output_path
-    from ..io.result_files import load_result, save_validation
-    from ..log_identification import run_validation
-    from ..validation import validation_table
+    from ..export.output_folder import check_output_path
+    from ..export.result_files import load_result, save_validation
+    from ..identification.log_identification import run_validation
+    from ..identification.validation import validation_table
+    from ..logs.log_files import load_log
 
     check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
     step = _steps(3)
     result = load_result(args.result)
     log = load_log(args.log, **log_options(args))
     if args.current:
-        from ..drive_gains import torques_from_currents
+        from ..identification.drive_gains import torques_from_currents
 
         log = torques_from_currents(result, log)
     elif result.drive_gains is not None:
@@ -200,17 +200,17 @@ def validate(args: argparse.Namespace) -> None:
 
 
 def export(args: argparse.Namespace) -> None:
-    from ..io.result_files import export_robot
+    from ..export.result_files import export_robot
 
     path = export_robot(args.source, args.urdf, name=args.name, overwrite=args.overwrite)
     print(f"wrote {path}", flush=True)
 
 
 def residual(args: argparse.Namespace) -> None:
-    from ..io.log_files import load_log
-    from ..io.output_folder import check_output_path, output_folder
-    from ..io.result_files import load_model_or_result
-    from ..observer import plot_residual, residual_from_log, save_residual
+    from ..export.output_folder import check_output_path, output_folder
+    from ..export.result_files import load_model_or_result
+    from ..identification.observer import plot_residual, residual_from_log, save_residual
+    from ..logs.log_files import load_log
 
     inputs = [args.model, args.log]
     check_output_path(args.output, args.overwrite, inputs=inputs)
@@ -228,7 +228,7 @@ def residual(args: argparse.Namespace) -> None:
 
 
 def info(args: argparse.Namespace) -> None:
-    from ..io.model_files import load_model
-    from ..summary import model_summary
+    from ..export.summary import model_summary
+    from ..model.model_files import load_model
 
     print(model_summary(load_model(args.model)))

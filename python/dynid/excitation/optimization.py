@@ -18,8 +18,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
 from .._threads import blas_single_threaded
-from ..base_parameters import BaseParameters, base_parameters
-from ..robot import Robot
+from ..model.base_parameters import BaseParameters, base_parameters
+from ..model.robot import Robot
 from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,

@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._checks import count, real_array
-from ..base_parameters import base_parameters
-from ..robot import Robot
+from ..model.base_parameters import base_parameters
+from ..model.robot import Robot
 
 #: Default velocity and acceleration limits for every joint [rad/s, rad/s^2]: about half the
 #: KUKA LWR4+'s rated joint speeds (110-180 deg/s), gentle enough for a first experiment.
@@ -211,7 +211,8 @@ def excitation_condition_number(
     one period, each column scaled to unit norm (inf when the motion leaves a column zero).
 
     ``scaled=False`` gives the plain 2-norm condition number instead, the one
-    :func:`dynid.identify.least_squares` reports; it depends on the parameters' units.
+    :func:`dynid.identification.identify.least_squares` reports; it depends on the parameters'
+    units.
     """
     if trajectory.n != robot.n:
         raise ValueError(f"trajectory: expected {robot.n} joints, got {trajectory.n}")

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _core
 from .._checks import real_array
-from ..robot import Robot
+from ..model.robot import Robot
 from .controllers import PD, ComputedTorque, Controller, PDGravity, gains, sample_reference
 
 METHODS = ("rk4", "euler")

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._checks import real_array
-from ..robot import Robot
+from ..model.robot import Robot
 
 Reference = Union[ArrayLike, tuple[ArrayLike, ArrayLike, ArrayLike], Callable[..., Any]]
 

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _core
 from .._checks import real_array
-from ..elastic import ElasticRobot
+from ..model.elastic import ElasticRobot
 from .closed_loop import _integer, _number, _vector
 from .controllers import Reference, sample_reference
 

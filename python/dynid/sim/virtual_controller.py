@@ -42,8 +42,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
 from .._checks import real_array
-from ..elastic import ElasticRobot
-from ..robot import Robot
+from ..model.elastic import ElasticRobot
+from ..model.robot import Robot
 from .closed_loop import Simulation, plant_friction, simulate
 from .controllers import PDGravity, sample_reference
 from .controllers import gains as check_gains

@@ -1,0 +1,448 @@
+"""Identification results on disk: ``result.json`` and the PNG plots of ``dynid identify``.
+
+``result.json`` holds everything needed to apply the model to another log with no other input:
+the model (DH table, joint types, convention, gravity, base/tool, limits), the regressor options,
+the base-parameter structure (independent columns and beta over the standard parameter names),
+the coefficients with their expressions and standard deviations, the condition number and rank,
+and the training log's preparation and per-joint fit. Non-finite numbers (a relative standard
+deviation of a coefficient that is exactly 0) are written as null. A physically consistent
+result (``identify_log(physical=True)``) also holds the identified parameters in ``model`` and
+the solver's report in ``physical``; ``load_result(...).robot`` is then the identified robot.
+``options.friction`` says whether the symmetric friction columns Fv, Fs are regressor columns
+(``base_parameters.parameter_names``), ``options.friction_model`` which friction model the
+result has ("none", "symmetric", "asymmetric"; :mod:`dynid.identification.friction_models`).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .._version import dynid_version
+from ..identification.friction_models import FRICTION_MODELS, asymmetric_count
+from ..identification.log_identification import LogIdentification, LogValidation
+from ..logs.log_files import Log
+from ..model.model_files import dumps_json, load_model, model_from_dict
+from ..model.robot import Robot
+from .output_folder import output_folder
+
+PathLike = Union[str, Path]
+
+FORMAT = "dynid-identification"
+#: Newest format version; the loader reads versions 1 (no covariance) to VERSION. A result is
+#: written with the lowest version that holds it, so that an older dynid reads every result it
+#: can apply and refuses, naming the version, the others: 2 (covariance, position torque) unless
+#: it has asymmetric friction (``options.friction_model``, version 3).
+VERSION = 3
+#: The version of results without asymmetric friction.
+VERSION_SYMMETRIC = 2
+#: Units of what a result holds (written into result.json for readers other than dynid).
+UNITS = {
+    "length": "m",
+    "angle": "rad",
+    "mass": "kg",
+    "time": "s",
+    "torque": "N m",
+    "coefficients": "SI, as their expressions over the standard parameters",
+}
+RESULT_FILE = "result.json"
+VALIDATION_FORMAT = "dynid-validation"
+#: Format version of validation.json (unchanged by the result's version 3).
+VALIDATION_VERSION = 2
+VALIDATION_FILE = "validation.json"
+
+
+def save_result(
+    result: LogIdentification,
+    folder: PathLike,
+    log: Log | None = None,
+    plots: bool = True,
+    overwrite: bool = False,
+    inputs: Iterable[PathLike | None] = (),
+) -> Path:
+    """Write ``folder/result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of
+    the fit on ``log`` (default: the training log, when the result kept it); returns the JSON
+    path. ``folder`` must be new or empty unless ``overwrite``, and ``overwrite`` replaces only a
+    folder dynid wrote that holds none of ``inputs`` nor the log's file; it is written as a
+    whole or not at all (:mod:`dynid.export.output_folder`)."""
+    log = log if log is not None else result.log
+    inputs = [*inputs, log.source if log is not None else None]
+    with output_folder(folder, overwrite, inputs=inputs) as staging:
+        (staging / RESULT_FILE).write_text(dumps_json(result_to_dict(result)) + "\n")
+        if plots and log is not None:
+            save_plots(staging, log, result.predict(log), "training log")
+    return Path(folder) / RESULT_FILE
+
+
+def save_validation(
+    validation: LogValidation,
+    folder: PathLike,
+    *,
+    result_source: str = "",
+    log_source: str = "",
+    plots: bool = True,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``folder/validation.json`` (per-joint metrics, preparation, sources) and, when
+    ``plots``, the torque and residual plots of the validation log; returns the JSON path.
+    ``overwrite`` never replaces a folder that holds ``result_source`` or the log's file
+    (:mod:`dynid.export.output_folder`)."""
+    report = {
+        "format": VALIDATION_FORMAT,
+        "version": VALIDATION_VERSION,
+        "dynid_version": dynid_version(),
+        "result": result_source,
+        "log": log_source,
+        "samples": validation.log.T,
+        "preparation": validation.preparation,
+        "notes": validation.log.notes,
+        "metrics": metrics_to_dict(validation.metrics),
+    }
+    inputs = [result_source, log_source, validation.log.source]
+    with output_folder(folder, overwrite, inputs=inputs) as staging:
+        (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
+        if plots:
+            save_plots(staging, validation.log, validation.predicted, "validation log")
+    return Path(folder) / VALIDATION_FILE
+
+
+def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str) -> list[Path]:
+    """``torques.png`` (measured and predicted torque per joint) and ``residuals.png``."""
+    from .plots import plot_residuals, plot_torques  # matplotlib: imported when plotting
+
+    t = log.t - log.t[0]
+    name = Path(log.source).name or what
+    return [
+        plot_torques(
+            t,
+            log.tau,
+            predicted,
+            folder / "torques.png",
+            title=f"Measured and predicted joint torques ({what}: {name})",
+        ),
+        plot_residuals(
+            t,
+            predicted - log.tau,
+            folder / "residuals.png",
+            title=f"Torque residuals, predicted - measured ({what}: {name})",
+        ),
+    ]
+
+
+def load_result(path: PathLike) -> LogIdentification:
+    """Read a result folder (or its JSON file). FileNotFoundError when absent; ValueError naming
+    the file and the field that is missing or malformed."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / RESULT_FILE
+    if not path.is_file():
+        raise FileNotFoundError(f"result: no such file: {path}")
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON: {exc.msg} at line {exc.lineno}") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file") from None
+    try:
+        return result_from_dict(data)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+
+
+def result_to_dict(result: LogIdentification) -> dict[str, Any]:
+    """The content of ``result.json`` (JSON-ready)."""
+    coefficients = [
+        {
+            "name": name,
+            "value": _num(value),
+            "std": _num(std),
+            "relative_std_percent": _num(rel),
+            "expression": expr,
+        }
+        for name, value, std, rel, expr in zip(
+            result.names, result.theta, result.std, result.relative_std, result.expressions
+        )
+    ]
+    training = dict(result.training)
+    training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
+    data = {
+        "format": FORMAT,
+        "version": VERSION if result.asymmetric_friction else VERSION_SYMMETRIC,
+        "dynid_version": dynid_version(),
+        "units": UNITS,
+        "model": result.model,
+        "options": {
+            "rotor": result.rotor,
+            "friction": result.friction,
+            "friction_model": result.friction_model,
+            "offset": result.offset,
+            "method": result.method,
+            "exclude_joints": list(result.excluded),
+            "position_torque_joints": [j + 1 for j in result.position_joints],
+        },
+        "condition_number": _num(result.condition_number),
+        "rank": result.rank,
+        "coefficients": coefficients,
+        "training": training,
+        "covariance": _nums(result.covariance) if result.covariance is not None else None,
+        "base_parameters": {
+            "count": result.count,
+            "parameter_names": result.parameter_names,
+            "independent": result.independent.tolist(),
+            "beta": _nums(result.beta),
+        },
+    }
+    if result.physical is not None:
+        data["physical"] = result.physical
+    if result.drive_gains is not None:
+        data["drive_gains"] = result.drive_gains
+    return data
+
+
+def result_from_dict(data: Any) -> LogIdentification:
+    """A LogIdentification from the content of ``result.json``."""
+    data = _object(data, "result")
+    if data.get("format") != FORMAT:
+        raise ValueError(
+            f"format: expected {FORMAT!r} (a dynid identify result), got {data.get('format')!r}"
+        )
+    version = data.get("version")
+    if not (isinstance(version, int) and not isinstance(version, bool) and 1 <= version <= VERSION):
+        raise ValueError(
+            f"version: expected a format version 1..{VERSION} (written by dynid "
+            f"{data.get('dynid_version', '?')}; this is dynid {dynid_version()}), "
+            f"got {version!r}"
+        )
+    model = _object(_get(data, "model"), "model")
+    try:
+        robot = model_from_dict(model)
+    except ValueError as exc:
+        raise ValueError(f"model: {exc}") from None
+    options = _object(_get(data, "options"), "options")
+    flags = {k: _get(options, k, "options") for k in ("rotor", "friction", "offset")}
+    for key, value in flags.items():
+        if not isinstance(value, bool):
+            raise ValueError(f"options.{key}: expected true or false, got {value!r}")
+    base = _object(_get(data, "base_parameters"), "base_parameters")
+    names_std = _get(base, "parameter_names", "base_parameters")
+    expected = robot.parameter_names(flags["rotor"], flags["friction"])
+    if names_std != expected:
+        raise ValueError(
+            f"base_parameters.parameter_names: do not match the model's regressor columns "
+            f"({len(expected)} expected for rotor={flags['rotor']}, friction={flags['friction']})"
+        )
+    independent = _array(
+        _get(base, "independent", "base_parameters"), "base_parameters.independent", 1
+    ).astype(np.int64)
+    count = independent.size
+    if np.any(independent < 0) or np.any(independent >= len(expected)):
+        raise ValueError("base_parameters.independent: column index out of range")
+    beta = _array(_get(base, "beta", "base_parameters"), "base_parameters.beta", 2)
+    if beta.shape != (count, len(expected)):
+        raise ValueError(
+            f"base_parameters.beta: expected shape {(count, len(expected))}, got {beta.shape}"
+        )
+    position_joints = _position_joints(options.get("position_torque_joints", []), robot.n)
+    asymmetric = _asymmetric_friction(options.get("friction_model"), flags["friction"])
+    p = count + (robot.n if flags["offset"] else 0) + 2 * len(position_joints)
+    p += asymmetric_count(robot.n, flags["offset"]) if asymmetric else 0
+    rows = _get(data, "coefficients")
+    if not isinstance(rows, list) or len(rows) != p:
+        raise ValueError(f"coefficients: expected a list of {p} entries")
+    records = [_object(row, f"coefficients[{k}]") for k, row in enumerate(rows)]
+    column = {
+        key: [_get(row, key, f"coefficients[{k}]") for k, row in enumerate(records)]
+        for key in ("name", "value", "std", "relative_std_percent", "expression")
+    }
+    training = _object(data.get("training", {}), "training")
+    metrics = _object(training.get("metrics", {}), "training.metrics")
+    training["metrics"] = {
+        k: _array(v, f"training.metrics.{k}", 1, nullable=True) for k, v in metrics.items()
+    }
+    method = _get(options, "method", "options")
+    physical = data.get("physical")
+    if physical is not None:
+        physical = _object(physical, "physical")
+        if not robot.is_physically_consistent():
+            raise ValueError(
+                "model: a physically consistent result whose parameters are not "
+                "physically consistent (edited file?)"
+            )
+    return LogIdentification(
+        model=dict(model),
+        rotor=flags["rotor"],
+        friction=flags["friction"],
+        offset=flags["offset"],
+        method=str(method),
+        parameter_names=list(names_std),
+        independent=independent,
+        beta=beta,
+        names=[str(x) for x in column["name"]],
+        expressions=[str(x) for x in column["expression"]],
+        theta=_array(column["value"], "coefficients[].value", 1),
+        std=_array(column["std"], "coefficients[].std", 1, nullable=True),
+        relative_std=_array(
+            column["relative_std_percent"], "coefficients[].relative_std_percent", 1, nullable=True
+        ),
+        condition_number=float(
+            _array(_get(data, "condition_number"), "condition_number", 0, nullable=True)
+        ),
+        rank=int(_array(_get(data, "rank"), "rank", 0)),
+        excluded=tuple(int(j) for j in options.get("exclude_joints", [])),
+        training=training,
+        covariance=_covariance(data.get("covariance"), p),
+        physical=physical,
+        position_joints=position_joints,
+        asymmetric_friction=asymmetric,
+        drive_gains=_drive_gains(data.get("drive_gains"), robot.n),
+        _robot=robot,
+    )
+
+
+def _asymmetric_friction(model: Any, friction: bool) -> bool:
+    """options.friction_model (absent before format version 3: from options.friction, which
+    says whether the symmetric Fv, Fs are regressor columns): whether the result has the
+    asymmetric friction columns."""
+    if model is None:
+        return False
+    expected = {"none": False, "symmetric": True, "asymmetric": False}
+    if model not in expected or expected[model] != friction:
+        raise ValueError(
+            f"options.friction_model: expected {', '.join(map(repr, FRICTION_MODELS))} "
+            f"matching options.friction = {str(friction).lower()}, got {model!r}"
+        )
+    return bool(model == "asymmetric")
+
+
+def _position_joints(value: Any, n: int) -> tuple[int, ...]:
+    """options.position_torque_joints (1-based, increasing; absent in older files: none) as
+    0-based joints."""
+    if not (
+        isinstance(value, list)
+        and all(isinstance(j, int) and not isinstance(j, bool) for j in value)
+        and all(1 <= j <= n for j in value)
+        and value == sorted(set(value))
+    ):
+        raise ValueError(
+            f"options.position_torque_joints: expected increasing joint numbers "
+            f"1..{n}, got {value!r}"
+        )
+    return tuple(j - 1 for j in value)
+
+
+def _drive_gains(value: Any, n: int) -> dict[str, Any] | None:
+    """drive_gains (results identified from motor currents; absent otherwise): an object whose
+    "gains" are n finite numbers."""
+    if value is None:
+        return None
+    report = _object(value, "drive_gains")
+    gains = _array(_get(report, "gains", "drive_gains"), "drive_gains.gains", 1)
+    if gains.size != n:
+        raise ValueError(f"drive_gains.gains: expected {n} gains, got {gains.size}")
+    return report
+
+
+def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:
+    if value is None:
+        return None
+    covariance = _array(value, "covariance", 2, nullable=True)
+    if covariance.shape != (size, size):
+        raise ValueError(f"covariance: expected shape ({size}, {size}), got {covariance.shape}")
+    return covariance
+
+
+def metrics_to_dict(metrics: dict[str, NDArray[np.float64]]) -> dict[str, list]:
+    """Per-joint metric arrays as JSON-ready lists (non-finite as null)."""
+    return {k: _nums(v) for k, v in metrics.items()}
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _num(value: Any) -> float | None:
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def _nums(value: Any) -> Any:
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 0:
+        return _num(array)
+    return [_nums(v) for v in array]
+
+
+def _object(value: Any, where: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise ValueError(f"{where}: expected an object, got {type(value).__name__}")
+    return dict(value)
+
+
+def _get(data: dict[str, Any], key: str, where: str = "") -> Any:
+    if key not in data:
+        raise ValueError(f"{where + '.' if where else ''}{key}: missing")
+    return data[key]
+
+
+def _array(value: Any, where: str, ndim: int, nullable: bool = False) -> NDArray[np.float64]:
+    """Numbers (nested lists) of ``ndim`` dimensions; null is inf where ``nullable``."""
+    if nullable:
+        value = _null_to_inf(value)
+    try:
+        if _has_bool(value):
+            raise TypeError
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: expected numbers, got {str(value)[:60]}") from None
+    if array.ndim != ndim:
+        raise ValueError(f"{where}: expected {ndim} dimension(s), got shape {array.shape}")
+    if not nullable and not np.all(np.isfinite(array)):
+        raise ValueError(f"{where}: contains null, NaN or inf")
+    return array
+
+
+def _null_to_inf(value: Any) -> Any:
+    if value is None:
+        return np.inf
+    return [_null_to_inf(v) for v in value] if isinstance(value, list) else value
+
+
+def _has_bool(value: Any) -> bool:
+    if isinstance(value, bool):
+        return True
+    return isinstance(value, list) and any(_has_bool(v) for v in value)
+
+
+def load_model_or_result(source: PathLike) -> Robot | LogIdentification:
+    """A result folder or ``result.json`` as a :class:`LogIdentification`, anything else as
+    :func:`~dynid.model.model_files.load_model` reads it (built-in name, model file, URDF)."""
+    path = Path(source)
+    if path.is_dir() or path.name == RESULT_FILE:
+        return load_result(path)
+    return load_model(source)
+
+
+def export_robot(
+    source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
+) -> Path:
+    """Write the robot of ``source`` as a URDF file (``dynid export``): ``source`` is a result
+    folder or ``result.json`` of a physically consistent identification, or anything
+    :func:`~dynid.model.model_files.load_model` reads (a built-in name, a model file, a URDF).
+    A least-squares result holds base parameters only, not a robot: a ValueError says so."""
+    loaded = load_model_or_result(source)
+    if isinstance(loaded, LogIdentification):
+        result = loaded
+        if result.physical is None:
+            raise ValueError(
+                f"{source}: a least-squares result holds base parameters only, not a full robot; "
+                "identify with --physical (dynid identify LOG --physical) to export a model"
+            )
+        robot = result.robot
+    else:
+        robot = loaded
+    robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
+    return Path(urdf)

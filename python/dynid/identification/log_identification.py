@@ -1,0 +1,602 @@
+"""Identification from a measurement log: the Python side of ``dynid identify`` and ``validate``.
+
+A log (``dynid.io``) and a robot model in, an identified torque model out (lecture, "Least
+Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
+
+1. the log is prepared (``dynid.io.prepare_log``: filtering, differentiation, decimation, sample
+   removal; each step only when asked, each in ``log.notes``);
+2. the regressor Y(q, qd, qdd) of every sample is computed in one batch call (C++), with the
+   rotor (Ia) and symmetric friction (Fv, Fs) columns when asked, and reduced to the base
+   parameters (``dynid.model.base_parameters``);
+3. optionally the asymmetric friction columns are appended
+(``dynid.identification.friction_models``: Fv+,
+   Fv-, Fs+, Fs- per joint, in place of Fv, Fs); one constant column per joint: a torque offset
+   (sensor bias; with Coulomb friction it also makes the friction asymmetric, Fs+ != Fs-); and,
+   optionally, a
+   position torque ks_j sin q_j + kc_j cos q_j per joint (``dynid.identification.position_torque``:
+   a once-per-turn torque of the joint's sensor, gear or cables; only on the joints where it is
+   structurally identifiable);
+4. the stacked system is solved by OLS or WLS (``dynid.identification.streaming``: the regressor
+chunk by
+   chunk into triangular factors, the solver of ``dynid.identification.identify.least_squares``);
+5. with ``physical=True``, the standard parameters are then estimated by the physically
+   consistent semidefinite programme (``dynid.identification.physical.physical_least_squares``:
+   same columns,
+   same WLS weights, the asymmetric friction coefficients >= 0, the offsets and position
+   torques unconstrained, optionally a prior model),
+   and the result carries
+   that robot (``result.robot``, saved with the result) and its base values as ``theta``.
+
+The result predicts torques on any log (``predict``), is checked on another log
+(:func:`validate_log`) and is saved to a folder by :func:`dynid.export.result_files.save_result`
+(JSON with everything needed to apply it again, including the model's DH table, plus PNG plots)
+and loaded back by :func:`dynid.load_result`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .._equality import ValueEquality
+from ..logs.log_files import Log
+from ..logs.preparation import prepare_log
+from ..model.base_parameters import base_parameters
+from ..model.model_files import load_model, model_from_dict, model_to_dict
+from ..model.robot import Robot
+from .friction_models import asymmetric_columns, asymmetric_count, asymmetric_names, friction_model
+from .identify import VARIANCE_FLOOR
+from .physical import physical_least_squares
+from .position_torque import position_columns, position_names, position_torque_joints
+from .streaming import LeastSquaresAccumulator
+from .validation import error_metrics, validation_table
+
+PathLike = Union[str, Path]
+
+#: Name of the torque-offset coefficient of joint j (1-based): "off1", "off2", ...
+OFFSET_NAME = "off"
+
+#: prior_weight of ``identify_log(physical=True, prior=...)`` when none is given: on the LWR4+
+#: logs (docs/real_data.md, "Physically consistent identification") the largest decade at which
+#: the relative training residual of the physical fit rises by less than 10 % over the prior-free
+#: fit; it pins the masses near the prior's while leaving the excited directions to the data.
+DEFAULT_PRIOR_WEIGHT = 1e-5
+
+#: Samples per regressor chunk folded into the least-squares factors.
+STREAM_CHUNK = 8192
+
+#: The options of dynid.io.prepare_log that ``preparation`` may hold.
+PREPARATION = (
+    "cutoff",
+    "order",
+    "differentiate",
+    "decimate",
+    "min_velocity",
+    "outlier_k",
+    "reference_tau",
+)
+
+
+@dataclass(eq=False)
+class LogIdentification(ValueEquality):
+    """An identified torque model tau = Y_base(q, qd, qdd) theta (+ offsets): see
+    :func:`identify_log`.
+
+    ``theta``, ``std`` and ``relative_std`` (percent) follow ``names``: the base parameters
+    (``expressions`` gives each as a combination of the standard ones), then the asymmetric
+    friction coefficients, the offsets and the position torques, when asked for.
+    ``independent`` and ``beta`` are those of :class:`dynid.BaseParameters` for the model's
+    regressor columns ``parameter_names``. ``training`` holds the training log's source, size,
+    preparation (options and notes, in words) and per-joint fit metrics.
+
+    ``friction`` says whether the regressor's symmetric friction columns (Fv, Fs) are among the
+    ``parameter_names``; ``asymmetric_friction`` whether the asymmetric ones
+    (:mod:`dynid.identification.friction_models`) follow the base parameters instead;
+    ``friction_model`` names the model ("none", "symmetric", "asymmetric").
+
+    A physically consistent result (``identify_log(physical=True)``) has ``physical`` set (the
+    solver's report: status, solver, times, prior, prior_weight, margin) and ``model`` holds the
+    identified standard parameters and drive terms, so ``robot`` is the identified robot;
+    ``theta`` holds its base values (beta @ pi) and the other coefficients; ``std`` is inf and
+    ``covariance`` None (the constrained estimate has no least-squares covariance).
+    """
+
+    model: dict[str, Any]  #: the robot model (``dynid.model.model_files`` format): DH table etc.
+    rotor: bool
+    friction: bool
+    offset: bool
+    method: str
+    parameter_names: list[str]  #: the P standard parameters (regressor columns)
+    independent: NDArray[np.int64]  #: base columns among them
+    beta: NDArray[np.float64]  #: (count, P): base parameters = beta @ pi
+    names: list[str]
+    expressions: list[str]
+    theta: NDArray[np.float64]
+    std: NDArray[np.float64]
+    relative_std: NDArray[np.float64]
+    condition_number: float
+    rank: int
+    excluded: tuple[int, ...] = ()
+    #: (count, count) covariance of ``theta`` (None for results saved before format version 2)
+    covariance: NDArray[np.float64] | None = None
+    training: dict[str, Any] = field(default_factory=dict)
+    physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
+    #: joints (0-based) with a position torque ks_j sin q_j + kc_j cos q_j (``position_torque``)
+    position_joints: tuple[int, ...] = ()
+    #: whether the asymmetric friction columns (Fv+, Fv-, Fs+, Fs-; Fs with offsets) are in
+    #: ``theta`` after the base parameters (then ``friction`` is False)
+    asymmetric_friction: bool = False
+    #: identified from motor currents (``dynid.identify_drive_gains``): the drive gains k
+    #: ("gains", "gains_std", tau = k * current), the payload that fixed their scale and the
+    #: runs; JSON-ready
+    drive_gains: dict[str, Any] | None = None
+    #: the prepared training log (not saved, not compared)
+    log: Log | None = field(default=None, repr=False, compare=False)
+    _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return len(self.model["rows"])
+
+    @property
+    def count(self) -> int:
+        """Number of base parameters (offsets not included)."""
+        return int(self.independent.size)
+
+    @property
+    def robot(self) -> Robot:
+        """The robot model, rebuilt from ``model``. For a least-squares result its parameters are
+        not the identified ones (these exist only as the base combinations ``theta``); for a
+        physically consistent one (``physical`` set) it is the identified robot."""
+        if self._robot is None:
+            self._robot = model_from_dict(self.model)
+        return self._robot
+
+    @property
+    def friction_model(self) -> str:
+        """The friction model: "none", "symmetric" or "asymmetric" (:mod:`.friction_models`)."""
+        if self.asymmetric_friction:
+            return "asymmetric"
+        return "symmetric" if self.friction else "none"
+
+    @property
+    def offsets(self) -> NDArray[np.float64]:
+        """(n,) the identified torque offsets (zeros without ``offset``)."""
+        if not self.offset:
+            return np.zeros(self.n)
+        first = self.count + (asymmetric_count(self.n, True) if self.asymmetric_friction else 0)
+        return np.asarray(self.theta[first : first + self.n], dtype=float)
+
+    @property
+    def position_torque(self) -> bool:
+        """Whether the model has position-torque columns (on ``position_joints``)."""
+        return bool(self.position_joints)
+
+    def regressor(self, q: Any, qd: Any, qdd: Any) -> NDArray[np.float64]:
+        """The (T, n, p) regressor of ``theta``: base columns, then the asymmetric friction
+        columns, the offset columns and the position-torque columns (sin q_j, cos q_j of each of
+        ``position_joints``), as many as the options ask for."""
+        robot = self.robot
+        total = robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
+        if total != len(self.parameter_names):
+            raise ValueError(
+                f"model: its regressor has {total} columns, the result expects "
+                f"{len(self.parameter_names)}"
+            )
+        # Only the base columns, selected in C++ (no full (T, n, P) array).
+        Y = robot.regressor(
+            q, qd, qdd, rotor=self.rotor, friction=self.friction, columns=self.independent
+        )
+        if Y.ndim == 2:
+            Y = Y[None]
+        return np.concatenate([Y, self.extra_columns(q, qd)], axis=2)
+
+    def extra_columns(self, q: Any, qd: Any) -> NDArray[np.float64]:
+        """(T, n, e) the columns of ``theta`` after the base parameters (asymmetric friction,
+        offsets, position torque): functions of q and qd only, none of the robot's parameters."""
+        q = np.asarray(q, dtype=float).reshape(-1, self.n)
+        blocks = [np.zeros((q.shape[0], self.n, 0))]
+        if self.asymmetric_friction:
+            qd = np.asarray(qd, dtype=float).reshape(q.shape)
+            blocks.append(asymmetric_columns(qd, self.offset))
+        if self.offset:
+            blocks.append(np.broadcast_to(np.eye(self.n), (q.shape[0], self.n, self.n)))
+        if self.position_joints:
+            blocks.append(position_columns(q, self.position_joints))
+        return np.concatenate(blocks, axis=2)
+
+    def extra_torque(self, q: Any, qd: Any) -> NDArray[np.float64]:
+        """(T, n) the torque of the :meth:`extra_columns` (asymmetric friction, offsets,
+        position torque): what the identified model adds to the rigid-body (+ rotor, symmetric
+        friction) torque of its base parameters."""
+        extra = self.extra_columns(q, qd)
+        return extra @ self.theta[self.count : self.count + extra.shape[2]]
+
+    def predict(self, log: Log) -> NDArray[np.float64]:
+        """Predicted joint torques (T, n) on ``log`` (qd, qdd computed from q when absent).
+
+        One batch regressor call in C++ for all samples, the base columns, then ``@ theta``.
+        """
+        log = _with_derivatives(log, self.n, self.model.get("name", ""))
+        return self.regressor(log.q, log.qd, log.qdd) @ self.theta
+
+    def summary(self) -> str:
+        """Coefficients (value, std, relative std, expression), condition number and rank, and
+        the per-joint fit on the training log, as text."""
+        options = ", ".join(
+            k.replace("_", " ")
+            for k in ("rotor", "friction", "asymmetric_friction", "offset", "position_torque")
+            if getattr(self, k)
+        )
+        offsets = ""
+        if self.asymmetric_friction:
+            offsets += (
+                f" + {asymmetric_count(self.n, self.offset)} asymmetric friction coefficients"
+            )
+        offsets += f" + {self.n} offsets" if self.offset else ""
+        if self.position_joints:
+            offsets += (
+                f" + position torque on joint(s) "
+                f"{', '.join(str(j + 1) for j in self.position_joints)}"
+            )
+        columns = "rigid body" + (f", {options}" if options else "")
+        model = (
+            f"model: {self.model.get('name') or '?'} ({self.n} joints, "
+            f"{self.model['convention']} DH); columns: {columns}"
+        )
+        fit = (
+            f"{self.count} base parameters{offsets}, {self.method.upper()}, rank "
+            f"{self.rank}/{self.theta.size}, condition number {self.condition_number:.4g}"
+        )
+        head = [model, fit]
+        if self.drive_gains is not None:  # identified from motor currents
+            gains = ", ".join(f"{k:.6g}" for k in self.drive_gains.get("gains", []))
+            head.append(f"drive gains k (tau = k * current): {gains}")
+        if self.physical is not None:
+            report = self.physical
+            prior = (
+                f"prior {report.get('prior')} (weight {report.get('prior_weight'):g})"
+                if report.get("prior")
+                else "no prior"
+            )
+            head.append(
+                f"physically consistent fit: SDP, {report.get('solver')} status "
+                f"{report.get('status')}, {prior}; the values are the base parameters of "
+                "the identified robot (no standard deviations)"
+            )
+        width = max(11, *(len(name) for name in self.names))
+        title = (
+            f"  {'coefficient':<{width}}  {'value':>12}  {'std':>10}  {'rel.std':>8}  expression"
+        )
+        lines = [title]
+        for name, value, std, rel, expr in zip(
+            self.names, self.theta, self.std, self.relative_std, self.expressions
+        ):
+            # No standard deviation (a physical fit: inf) is a dash, not "inf inf%".
+            spread = f"{std:>10.3g}  {rel:>7.3g}%" if np.isfinite(std) else f"{'-':>10}  {'-':>8}"
+            lines.append(f"  {name:<{width}}  {value:>12.5g}  {spread}  {expr}")
+        text = "\n".join(head + lines)
+        metrics = self.training.get("metrics")
+        if metrics:
+            arrays = {k: np.asarray(v, dtype=float) for k, v in metrics.items()}
+            text += f"\nfit on the training log ({self.training.get('samples')} samples):\n"
+            text += validation_table(arrays)
+        return text
+
+
+def identify_log(
+    log: Log,
+    robot: Robot,
+    *,
+    rotor: bool = False,
+    friction: bool | str = False,
+    offset: bool = False,
+    method: str = "wls",
+    exclude_joints: Sequence[int] = (),
+    preparation: Mapping[str, Any] | None = None,
+    physical: bool = False,
+    prior: Robot | PathLike | None = None,
+    prior_weight: float | None = None,
+    position_torque: bool = False,
+) -> LogIdentification:
+    """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
+
+    ``preparation``: options of :func:`dynid.io.prepare_log` (cutoff, order, differentiate,
+    decimate, min_velocity, outlier_k) applied first; qd and qdd are computed from q when the log
+    lacks them. ``rotor`` adds the Ia columns; ``friction`` the friction model: False ("none"),
+    True or "symmetric" (Fv qd + Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a
+    coefficient per direction of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
+    Coulomb asymmetry: :mod:`dynid.identification.friction_models`). ``offset`` adds one constant
+    torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
+    these two columns are structurally identifiable next to the others
+    (:func:`dynid.identification.position_torque.position_torque_joints`; the joints left out are
+    named in
+    ``training["notes"]``): a joint-side torque that depends on the joint's own position (torque
+    sensor or gear ripple once per turn, cable or spring stiffness; docs/identification.md).
+    ``method`` is "ols" or "wls" (weighted by each joint's noise level, the
+    default: the joints' torques differ by two orders of magnitude). ``exclude_joints`` (0-based)
+    leaves those joints' rows out of the fit. Raises ValueError (RankDeficientError) when the log
+    does not excite every base parameter.
+
+    ``physical=True`` estimates physically consistent standard parameters instead
+    (:func:`dynid.physical_least_squares`, same columns; WLS weights 1/sigma_j from the
+    least-squares residuals; the asymmetric friction coefficients >= 0, the offsets and
+    position torques unconstrained; excluded joints weighted 0). ``prior`` is a
+    Robot, a URDF file or a model file (``dynid.load_model``: JSON/YAML or a built-in name) of
+    the same arm, in any DH table (re-expressed in ``robot``'s frames by
+    :func:`dynid.model.link_frames.express_in_frames_of` when needed); ``prior_weight`` defaults to
+    ``DEFAULT_PRIOR_WEIGHT`` when a prior is given. A log that does not excite every base
+    parameter is then a RuntimeWarning, not an error: the constraints and the prior fix the
+    unexcited directions (without a prior, any values the constraints allow), which the physical
+    fit's UserWarning says too (its extra columns named ``extra[k]``). Raises
+    :class:`dynid.PhysicalIdentificationError` when the solver fails.
+    """
+    if not isinstance(log, Log):
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+    if not isinstance(robot, Robot):
+        raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
+    if not isinstance(physical, (bool, np.bool_)):
+        raise ValueError(f"physical: expected True or False, got {physical!r}")
+    kind = friction_model(friction)
+    symmetric, asymmetric = kind == "symmetric", kind == "asymmetric"
+    if asymmetric and robot.coupled:
+        raise ValueError(
+            "friction: the asymmetric model acts on each joint's velocity, but the robot's drives "
+            "are coupled (robot.transmission); friction=True gives the motor-side friction "
+            "T^T (Fv T qd + Fs sign(T qd))"
+        )
+    if not isinstance(position_torque, (bool, np.bool_)):
+        raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
+    if not physical and (prior is not None or prior_weight is not None):
+        raise ValueError("prior: a prior (and prior_weight) needs physical=True")
+    prior_robot = _prior_model(prior) if prior is not None else None
+    if prior_robot is not None and prior_weight is None:
+        prior_weight = DEFAULT_PRIOR_WEIGHT
+    options = _options(preparation)
+    prepared = _with_derivatives(prepare_log(log, **options), robot.n, robot.name)
+    qd, qdd = prepared.qd, prepared.qdd
+    assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
+    base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
+    names, expressions = list(base.names), list(base.expressions)
+    if asymmetric:
+        more_names, more_expressions = asymmetric_names(robot.n, bool(offset))
+        names += more_names
+        expressions += more_expressions
+    if offset:
+        names += [f"{OFFSET_NAME}{j}" for j in range(1, robot.n + 1)]
+        expressions += [f"torque offset of joint {j}" for j in range(1, robot.n + 1)]
+    joints: tuple[int, ...] = ()
+    left_out: tuple[int, ...] = ()
+    if position_torque:
+        # The symmetric friction columns stand in for the asymmetric ones: sin q_j, cos q_j
+        # are functions of q_j, independent of any function of qd_j alone either way.
+        joints, left_out = position_torque_joints(
+            robot, bool(rotor), symmetric or asymmetric, bool(offset)
+        )
+        more_names, more_expressions = position_names(joints)
+        names += more_names
+        expressions += more_expressions
+    result = LogIdentification(
+        model=model_to_dict(robot),
+        rotor=bool(rotor),
+        friction=symmetric,
+        offset=bool(offset),
+        method=method,
+        parameter_names=list(base.parameter_names),
+        independent=base.independent.copy(),
+        beta=base.beta.copy(),
+        names=names,
+        expressions=expressions,
+        theta=np.zeros(len(names)),
+        std=np.zeros(len(names)),
+        relative_std=np.zeros(len(names)),
+        condition_number=np.nan,
+        rank=0,
+        log=prepared,
+        position_joints=joints,
+        asymmetric_friction=asymmetric,
+        _robot=robot,
+    )
+    # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
+    # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
+    chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
+    accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
+    for c in chunks:
+        accumulator.add(result.regressor(prepared.q[c], qd[c], qdd[c]), prepared.tau[c])
+    # The physical fit needs the least squares only for the rank, the condition number and the
+    # WLS weights: directions the data do not excite are then fixed by the constraints and the
+    # prior, so rank deficiency is a warning there instead of an error.
+    fit = accumulator.solve(
+        method=method, names=names, on_rank_deficient="warn" if physical else "raise"
+    )
+    result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
+    result.condition_number, result.rank = fit.condition_number, fit.rank
+    result.covariance = fit.covariance
+    result.excluded = fit.excluded
+    for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
+        result.model.pop(key, None)
+    if physical:
+        _physical(result, prepared, fit.noise_variance, prior_robot, prior_weight or 0.0, prior)
+    result.training = {
+        "source": prepared.source,
+        "samples": prepared.T,
+        "duration_s": prepared.duration,
+        "sampling_rate_hz": prepared.fs,
+        "preparation": {k: _plain(v) for k, v in options.items()},
+        "notes": list(prepared.notes) + _position_notes(left_out),
+        "metrics": error_metrics(
+            prepared.tau,
+            np.concatenate(
+                [result.regressor(prepared.q[c], qd[c], qdd[c]) @ result.theta for c in chunks]
+            ),
+        ),
+    }
+    return result
+
+
+def _physical(
+    result: LogIdentification,
+    log: Log,
+    noise_variance: NDArray[np.float64],
+    prior: Robot | None,
+    prior_weight: float,
+    source: Any,
+) -> None:
+    """Replace the least-squares estimate in ``result`` by the physically consistent one."""
+    robot, n = result.robot, result.n
+    assert log.qd is not None and log.qdd is not None  # the prepared log (_with_derivatives)
+    Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
+    if Y.ndim == 2:
+        Y = Y[None]
+    columns = result.extra_columns(log.q, log.qd)
+    Y = np.concatenate([Y, columns], axis=2)
+    # Friction dissipates: the asymmetric coefficients are >= 0, as Fv and Fs are.
+    nonnegative = np.zeros(columns.shape[2], dtype=bool)
+    if result.asymmetric_friction:
+        nonnegative[: asymmetric_count(n, result.offset)] = True
+    weights = np.ones(n)
+    kept = [j for j in range(n) if j not in result.excluded]
+    usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
+    if result.method == "wls" and usable:  # as dynid.least_squares: 1 / sigma_j
+        floored = np.maximum(noise_variance, VARIANCE_FLOOR * noise_variance.max())
+        weights[kept] = 1.0 / np.sqrt(floored)
+    weights[list(result.excluded)] = 0.0
+    fit = physical_least_squares(
+        robot,
+        Y,
+        log.tau,
+        rotor=result.rotor,
+        friction=result.friction,
+        weights=weights,
+        prior=prior,
+        prior_weight=prior_weight,
+        extra_columns=columns.shape[2],
+        nonnegative_extra=nonnegative,
+    )
+    result.theta = np.concatenate([fit.base_values, fit.extra])
+    result.std = np.full(result.theta.size, np.inf)
+    result.relative_std = np.full(result.theta.size, np.inf)
+    result.covariance = None
+    result.model = model_to_dict(fit.robot)
+    result._robot = fit.robot
+    result.physical = {
+        "status": fit.status,
+        "solver": fit.solver,
+        "solve_time_s": fit.solve_time if np.isfinite(fit.solve_time) else None,
+        "setup_time_s": fit.setup_time,
+        "objective": fit.objective,
+        "prior": None
+        if source is None
+        else (str(source) if not isinstance(source, Robot) else f"<Robot {source.name}>"),
+        "prior_weight": prior_weight,
+        "margin": fit.options["margin"],
+        "projected_links": [i + 1 for i in fit.projected],
+        "min_pseudo_inertia_eigenvalues": fit.min_eigenvalues.tolist(),
+    }
+
+
+def _position_notes(left_out: tuple[int, ...]) -> list[str]:
+    if not left_out:
+        return []
+    joints = ", ".join(str(j + 1) for j in left_out)
+    return [
+        f"position torque: not on joint(s) {joints}, where sin q, cos q are combinations of "
+        "the rigid-body columns (gravity) and cannot be told apart from them"
+    ]
+
+
+def _prior_model(prior: Any) -> Robot:
+    """The prior: a Robot, or what ``dynid.load_model`` reads (a model file, a URDF, a built-in
+    name)."""
+    if isinstance(prior, Robot):
+        return prior
+    if not isinstance(prior, (str, Path)):
+        raise ValueError(
+            f"prior: expected a dynid.Robot or the path of a model file or URDF, "
+            f"got {type(prior).__name__}"
+        )
+    return load_model(prior)
+
+
+@dataclass(eq=False)
+class LogValidation(ValueEquality):
+    """An identified model applied to another log: the prepared log, the predicted torques and
+    the per-joint errors (:func:`dynid.identification.validation.error_metrics`)."""
+
+    log: Log  #: the validation log after ``preparation``
+    predicted: NDArray[np.float64]
+    metrics: dict[str, NDArray[np.float64]]
+    preparation: dict[str, Any]
+    notes: list[str] = field(default_factory=list)  #: differences from the training preparation
+
+
+def run_validation(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> LogValidation:
+    """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
+    and measure the errors; ``notes`` says where the preparation differs from the training
+    log's (a low-pass on one and not the other biases the comparison)."""
+    options = _options(preparation)
+    prepared = prepare_log(log, **options) if options else log
+    predicted = result.predict(prepared)
+    notes = []
+    trained = result.training.get("preparation", {}).get("cutoff")
+    if trained != options.get("cutoff"):
+        notes.append(
+            f"the training log was {_filtered(trained)}, this one is "
+            f"{_filtered(options.get('cutoff'))}"
+        )
+    return LogValidation(
+        prepared, predicted, error_metrics(prepared.tau, predicted), options, notes
+    )
+
+
+def validate_log(
+    result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
+) -> dict[str, NDArray[np.float64]]:
+    """Per-joint errors of ``result`` on another log (``prepare_log(log, **preparation)``
+    first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
+    ``r2`` and ``mse`` (see :func:`dynid.identification.validation.error_metrics`)."""
+    return run_validation(result, log, preparation=preparation).metrics
+
+
+def _filtered(cutoff: float | None) -> str:
+    return "not low-passed" if cutoff is None else f"low-passed at {cutoff:g} Hz"
+
+
+def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The prepare_log options given (None values left out), checked by name."""
+    options = {k: v for k, v in dict(preparation or {}).items() if v is not None}
+    unknown = sorted(set(options) - set(PREPARATION))
+    if unknown:
+        raise ValueError(
+            f"preparation: unknown option(s) {unknown}; expected some of "
+            f"{', '.join(PREPARATION)} (dynid.io.prepare_log)"
+        )
+    return options
+
+
+def _plain(value: Any) -> Any:
+    """A JSON-ready record of an option value (a callable reference torque by its name)."""
+    if callable(value):
+        return f"<{getattr(value, '__name__', type(value).__name__)}>"
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        return str(value)
+    return array.tolist() if array.size <= 64 else f"<array of shape {array.shape}>"
+
+
+def _with_derivatives(log: Log, n: int, name: str) -> Log:
+    if not isinstance(log, Log):
+        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+    if log.n != n:
+        raise ValueError(f"log: has {log.n} joints, but the model {name!r} has {n}")
+    if log.qd is None or log.qdd is None:
+        log = prepare_log(log, differentiate="missing")
+    return log

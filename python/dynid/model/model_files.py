@@ -1,0 +1,399 @@
+"""Robot models from files: a DH table in JSON (or YAML, when PyYAML is installed), or a
+built-in name.
+
+A model file is one object (format in ``docs/cli.md``)::
+
+    {"name": "KUKA LWR4+", "convention": "standard", "joint_types": "RRRRRRR",
+     "gravity": [0, 0, -9.81],
+     "rows": [{"a": 0, "alpha": 1.5707963267948966, "d": 0.3105, "theta": 0}, ...]}
+
+``convention`` and ``rows`` are required. Each row is an object ``{a, alpha, d, theta}`` (SPEC §2;
+``theta_offset`` is accepted for ``theta``) or a list ``[a, alpha, d, theta]``; in modified DH the
+names ``a_prev`` and ``alpha_prev`` (a_{i-1}, alpha_{i-1}) may replace ``a`` and ``alpha``, as in
+the LWR4+ tables of ``tests/data/kuka_lwr4_dh.json``. Optional: ``name``, ``joint_types`` (default
+all revolute), ``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4), ``qlim`` (n x 2),
+``params`` (n x 10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each), ``transmission``
+(n x n coupling matrix T, theta_dot = T qd; docs/transmission.md; absent means identity). Unknown
+fields are errors, so that a misspelt ``gravity`` is not silently replaced by the default.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+
+from .._checks import MAX_JOINTS
+from . import models
+from .robot import Robot
+
+PathLike = Union[str, Path]
+
+#: Built-in models by name (``dynid.model.models``).
+BUILTIN_MODELS: dict[str, Callable[[], Robot]] = {
+    "kuka_lwr4": models.kuka_lwr4,
+    "puma560": models.puma560,
+    "planar_2r": models.planar_2r,
+    "panda": models.panda,
+    "ur5": models.ur5,
+    "ur10": models.ur10,
+}
+
+FORMAT = "dynid-model"
+#: Fields a model file may hold besides the model itself (ignored).
+METADATA = ("format", "version", "description", "notes", "source", "units")
+FIELDS = (
+    "name",
+    "convention",
+    "joint_types",
+    "gravity",
+    "rows",
+    "base",
+    "tool",
+    "qlim",
+    "params",
+    "Ia",
+    "Fv",
+    "Fs",
+    "transmission",
+)
+#: Row fields: the standard name, then the names accepted for it.
+ROW_NAMES = {
+    "standard": {"a": ("a",), "alpha": ("alpha",), "d": ("d",), "theta": ("theta", "theta_offset")},
+    "modified": {
+        "a": ("a", "a_prev"),
+        "alpha": ("alpha", "alpha_prev"),
+        "d": ("d",),
+        "theta": ("theta", "theta_offset"),
+    },
+}
+YAML_SUFFIXES = (".yaml", ".yml")
+
+#: Limits on what a file may ask for (docs/cli.md), checked before any work; the number of
+#: joints, MAX_JOINTS, is shared with URDF reading (dynid._checks).
+MAX_FILE_BYTES = 16 * 2**20
+MAX_YAML_ALIASES = 100
+MAX_EXPANDED_VALUES = 1_000_000
+
+
+def load_model(path_or_name: PathLike) -> Robot:
+    """A built-in model (``kuka_lwr4``, ``puma560``, ``planar_2r``, ``panda``, ``ur5``,
+    ``ur10``), a model file (JSON/YAML) or a URDF file (``.urdf``: :meth:`Robot.from_urdf` with
+    its defaults: the whole chain from the root to the single leaf, standard DH).
+
+    Raises FileNotFoundError for a missing file and ValueError naming the field that is missing
+    or malformed (prefixed by the file name).
+    """
+    text = str(path_or_name)
+    if text in BUILTIN_MODELS:
+        return BUILTIN_MODELS[text]()
+    path = Path(text)
+    if not path.is_file():
+        if path.suffix == "" and len(path.parts) == 1:
+            raise ValueError(
+                f"model: {text!r} is neither a built-in model ({', '.join(BUILTIN_MODELS)}) "
+                "nor an existing file"
+            )
+        raise FileNotFoundError(f"model: no such file: {path}")
+    try:
+        if path.suffix.lower() == ".urdf":
+            if path.stat().st_size > MAX_FILE_BYTES:
+                raise ValueError(f"more than {MAX_FILE_BYTES} bytes: not a robot description")
+            return Robot.from_urdf(path)
+        return model_from_dict(read_structured(path))
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+
+
+def save_model(robot: Robot, path: PathLike) -> Path:
+    """Write ``robot`` as a model file (JSON, or YAML for .yaml/.yml when PyYAML is installed).
+
+    ``load_model`` of the file gives back the same table, transforms, limits, parameters and
+    drive terms (floats are written with 17 significant digits, i.e. exactly).
+    """
+    path = Path(path)
+    data = model_to_dict(robot)
+    if path.suffix.lower() in YAML_SUFFIXES:
+        yaml = _yaml(path)
+        path.write_text(yaml.safe_dump(data, sort_keys=False))
+    elif path.suffix.lower() == ".json":
+        path.write_text(dumps_json(data) + "\n")
+    else:
+        raise ValueError(f"path: unknown extension {path.suffix!r}; expected .json, .yaml or .yml")
+    return path
+
+
+# --------------------------------------------------------------------------- dict <-> Robot
+
+
+def model_from_dict(data: Any) -> Robot:
+    """A Robot from the parsed content of a model file (see the module docstring)."""
+    if not isinstance(data, Mapping):
+        raise ValueError(f"expected an object with the model's fields, got {type(data).__name__}")
+    unknown = [str(k) for k in data if k not in FIELDS and k not in METADATA]
+    if unknown:
+        hint = ""
+        if "rows" not in data and isinstance(data.get("dh"), Mapping):
+            hint = " (the DH rows must be a top-level 'rows' list, with 'convention')"
+        raise ValueError(
+            f"unknown field(s) {', '.join(repr(k) for k in unknown)}{hint}; expected "
+            f"{', '.join(FIELDS)}"
+        )
+    for key in ("convention", "rows"):
+        if key not in data:
+            raise ValueError(f"{key}: missing (a model needs 'convention' and 'rows')")
+    convention = data["convention"]
+    if convention not in ROW_NAMES:
+        raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
+    rows = data["rows"]
+    if not isinstance(rows, list) or not rows:
+        raise ValueError(f"rows: expected a non-empty list of DH rows, got {rows!r:.60}")
+    if len(rows) > MAX_JOINTS:
+        raise ValueError(
+            f"rows: {len(rows)} DH rows; dynid model files hold at most {MAX_JOINTS} joints"
+        )
+    dh = np.array([_row(row, i, convention) for i, row in enumerate(rows)])
+    n = len(dh)
+    name = data.get("name")
+    if name is not None and not isinstance(name, str):
+        raise ValueError(f"name: expected a string, got {name!r}")
+    joint_types = data.get("joint_types", "R" * n)
+    if not isinstance(joint_types, str):
+        raise ValueError(f"joint_types: expected a string of R/P letters, got {joint_types!r}")
+    arrays = {
+        key: _numbers(data[key], key, shape)
+        for key, shape in (
+            ("gravity", (3,)),
+            ("base", (4, 4)),
+            ("tool", (4, 4)),
+            ("qlim", (n, 2)),
+            ("params", (n, 10)),
+            ("Ia", (n,)),
+            ("Fv", (n,)),
+            ("Fs", (n,)),
+            ("transmission", (n, n)),
+        )
+        if data.get(key) is not None
+    }
+    robot = Robot.from_dh(
+        dh,
+        joint_types,
+        convention,
+        arrays.get("gravity", (0.0, 0.0, -9.81)),
+        params=arrays.get("params"),
+        base=arrays.get("base"),
+        tool=arrays.get("tool"),
+        qlim=arrays.get("qlim"),
+        name=name,
+    )
+    for key in ("Ia", "Fv", "Fs", "transmission"):
+        if key in arrays:
+            setattr(robot, key, arrays[key])
+    return robot
+
+
+def model_to_dict(robot: Robot) -> dict[str, Any]:
+    """The content of a model file for ``robot`` (JSON-ready: lists and floats)."""
+    if robot.convention == "modified":
+        keys = ("a_prev", "alpha_prev", "d", "theta")
+    else:
+        keys = ("a", "alpha", "d", "theta")
+    data: dict[str, Any] = {
+        "format": FORMAT,
+        "name": str(getattr(robot, "name", "")),
+        "convention": robot.convention,
+        "joint_types": robot.joint_types,
+        "gravity": _floats(robot.gravity_vector),
+        "rows": [dict(zip(keys, _floats(row))) for row in robot.dh],
+    }
+    for key in ("base", "tool"):
+        value = np.asarray(getattr(robot, key))
+        if not np.array_equal(value, np.eye(4)):
+            data[key] = _floats(value)
+    data["qlim"] = _floats(robot.qlim)
+    data["params"] = _floats(robot.params)
+    for key in ("Ia", "Fv", "Fs"):
+        data[key] = _floats(getattr(robot, key))
+    if robot.coupled:
+        data["transmission"] = _floats(robot.transmission)
+    return data
+
+
+def _row(row: Any, i: int, convention: str) -> list[float]:
+    where = f"rows[{i}]"
+    if isinstance(row, list):
+        return _numbers(row, where, (4,)).tolist()
+    if not isinstance(row, Mapping):
+        raise ValueError(
+            f"{where}: expected an object {{a, alpha, d, theta}} or a list of 4 numbers, "
+            f"got {row!r:.60}"
+        )
+    names = ROW_NAMES[convention]
+    accepted = {alias for aliases in names.values() for alias in aliases}
+    for key in row:
+        if key not in accepted:
+            note = ""
+            if key in ROW_NAMES["modified"]["a"] + ROW_NAMES["modified"]["alpha"]:
+                note = f" ({key!r} is modified-DH notation, but convention is {convention!r})"
+            raise ValueError(
+                f"{where}: unknown field {key!r}{note}; expected {', '.join(sorted(accepted))}"
+            )
+    values = []
+    for field, aliases in names.items():
+        given = [alias for alias in aliases if alias in row]
+        if not given:
+            raise ValueError(f"{where}: missing {' or '.join(repr(a) for a in aliases)}")
+        if len(given) > 1:
+            raise ValueError(f"{where}: both {given[0]!r} and {given[1]!r} given for {field}")
+        values.append(_number(row[given[0]], f"{where}.{given[0]}"))
+    return values
+
+
+def _number(value: Any, where: str) -> float:
+    try:
+        number = float(value) if not isinstance(value, (bool, str, bytes)) else np.nan
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond 1e308
+        number = np.nan
+    if not isinstance(value, (int, float)) or not np.isfinite(number):
+        raise ValueError(f"{where}: expected a finite number, got {value!r:.60}")
+    return number
+
+
+def _numbers(value: Any, where: str, shape: tuple[int, ...]) -> np.ndarray:
+    """A float array of ``shape`` from nested lists of numbers (10n is accepted for (n, 10))."""
+    try:
+        if isinstance(value, (str, bytes)) or _has_bool(value):
+            raise TypeError
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        array = None
+    if array is None or not (
+        array.shape == shape or (shape[-1:] == (10,) and array.shape == (shape[0] * 10,))
+    ):
+        got = f"shape {array.shape}" if array is not None else f"{value!r:.60}"
+        raise ValueError(f"{where}: expected numbers of shape {shape}, got {got}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{where}: contains NaN or inf")
+    return array
+
+
+def _has_bool(value: Any) -> bool:
+    if isinstance(value, bool):
+        return True
+    return isinstance(value, list) and any(_has_bool(v) for v in value)
+
+
+def _floats(value: Any) -> Any:
+    return np.asarray(value, dtype=float).tolist()
+
+
+# --------------------------------------------------------------------------- files
+
+
+def read_structured(path: Path) -> Any:
+    """The parsed content of a JSON or YAML file; ValueError with the place of a syntax error."""
+    suffix = path.suffix.lower()
+    if suffix not in YAML_SUFFIXES and suffix != ".json":
+        raise ValueError(f"unknown extension {path.suffix!r}; expected .json, .yaml or .yml")
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise ValueError(
+            f"{size} bytes is more than a model or result file can need "
+            f"(limit {MAX_FILE_BYTES} bytes)"
+        )
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise ValueError("not a text file") from None
+    try:
+        if suffix in YAML_SUFFIXES:
+            return _load_yaml(text, path)
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(
+            f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}"
+        ) from None
+    except RecursionError:
+        raise ValueError("nesting too deep to be a model or result file") from None
+
+
+def _load_yaml(text: str, path: Path) -> Any:
+    """YAML through PyYAML's safe loader, with at most MAX_YAML_ALIASES aliases: a few hundred
+    bytes of nested aliases (a "billion laughs" file) would otherwise expand to gigabytes."""
+    yaml = _yaml(path)
+
+    # yaml is a module object here (imported on demand), which mypy cannot use as a base class.
+    class BoundedLoader(yaml.SafeLoader):  # type: ignore[name-defined]
+        aliases = 0
+
+        def compose_node(self, parent: Any, index: Any) -> Any:
+            if self.check_event(yaml.events.AliasEvent):
+                self.aliases += 1
+                if self.aliases > MAX_YAML_ALIASES:
+                    raise ValueError(f"more than {MAX_YAML_ALIASES} YAML aliases (&/*): refused")
+            return super().compose_node(parent, index)
+
+    try:
+        data = yaml.load(text, Loader=BoundedLoader)
+    except yaml.YAMLError as exc:
+        raise ValueError(f"not valid YAML ({exc})".replace("\n", " ")) from None
+    _check_expanded_size(data)
+    return data
+
+
+def _check_expanded_size(data: Any) -> None:
+    """Aliases share one object; counted as often as they are referenced, a file's values must
+    stay below MAX_EXPANDED_VALUES (few aliases nested deeply still multiply)."""
+    budget = [MAX_EXPANDED_VALUES]
+
+    def visit(value: Any) -> None:
+        budget[0] -= 1
+        if budget[0] < 0:
+            raise ValueError(
+                f"the YAML file expands to more than {MAX_EXPANDED_VALUES} values "
+                "(nested aliases): refused"
+            )
+        children = value.values() if isinstance(value, dict) else value
+        if isinstance(value, (dict, list)):
+            for child in children:
+                visit(child)
+
+    visit(data)
+
+
+def _yaml(path: Path) -> Any:
+    try:
+        import yaml
+    except ImportError:
+        raise ValueError(
+            f"{path.suffix} files need PyYAML, which is not installed (it is not a dynid "
+            "dependency): `pip install pyyaml`, or write the model as JSON"
+        ) from None
+    return yaml
+
+
+def dumps_json(value: Any, indent: int = 0) -> str:
+    """JSON with objects one field per line and lists of numbers (or of such lists, or of flat
+    objects) on one line each: readable DH tables and parameter matrices, exact floats."""
+    pad, inner = " " * indent, " " * (indent + 2)
+    if isinstance(value, Mapping) and value and not _flat(value):
+        items = [
+            f"{inner}{json.dumps(str(k))}: {dumps_json(v, indent + 2)}" for k, v in value.items()
+        ]
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if isinstance(value, list) and value and not _flat(value):
+        items = [inner + dumps_json(v, indent + 2) for v in value]
+        return "[\n" + ",\n".join(items) + "\n" + pad + "]"
+    return json.dumps(value, allow_nan=False, separators=(", ", ": "))
+
+
+def _flat(value: Any) -> bool:
+    """Lists of scalars, and objects of at most 6 scalars (a DH row), go on one line."""
+    scalars = (str, int, float, bool, type(None))
+    items = list(value.values()) if isinstance(value, Mapping) else value
+    return all(isinstance(v, scalars) for v in items) and (
+        isinstance(value, list) or len(items) <= 6
+    )
