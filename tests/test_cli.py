@@ -13,7 +13,7 @@ import pytest
 import dynid
 from dynid.cli import main
 from dynid.export.result_files import load_result
-from dynid.io import save_log
+from dynid.logs import save_log
 from dynid.model.model_files import save_model
 from test_log_identification import PNG, fourier_log
 
@@ -168,7 +168,7 @@ def test_identify_position_torque(files, tmp_path, capsys):
     log = fourier_log(arm, 1, seconds=4.0)
     tau = log.tau.copy()
     tau[:, 1] += 0.3 * np.sin(log.q[:, 1]) - 0.2 * np.cos(log.q[:, 1])
-    save_log(dynid.io.Log(t=log.t, q=log.q, tau=tau, qd=log.qd, qdd=log.qdd), tmp_path / "p.npz")
+    save_log(dynid.Log(t=log.t, q=log.q, tau=tau, qd=log.qd, qdd=log.qdd), tmp_path / "p.npz")
     out = tmp_path / "ident"
     assert (
         main(

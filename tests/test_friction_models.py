@@ -29,7 +29,7 @@ from dynid.identification.friction_models import (
 )
 from dynid.identification.log_identification import identify_log, validate_log
 from dynid.identification.observer import residual_from_log, robot_from_identification
-from dynid.io import Log, save_log
+from dynid.logs import Log, save_log
 from dynid.model.model_files import save_model
 from test_log_identification import fourier_log
 

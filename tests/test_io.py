@@ -1,4 +1,4 @@
-"""dynid.io: file formats, round trips, the real KUKA LWR4+ log, malformed files, prepare_log."""
+"""dynid.logs (and its 0.2 name dynid.io): file formats, round trips, the real KUKA LWR4+ log, malformed files, prepare_log."""
 
 from __future__ import annotations
 
@@ -485,3 +485,12 @@ def test_prepare_log_refuses_to_filter_a_log_with_gaps() -> None:
     with pytest.raises(ValueError, match=r"t: .* gap of 0.505 s .* after sample 199"):
         prepare_log(gappy, cutoff=5.0)
     prepare_log(gappy, min_velocity=0.01)  # selection alone is fine
+
+
+def test_the_0_2_name_dynid_io_gives_the_same_log_layer() -> None:
+    # Code written against dynid 0.2 imported the log layer as dynid.io (docs/architecture.md).
+    import dynid.io
+    import dynid.logs
+
+    for name in ("Log", "load_log", "prepare_log", "save_log"):
+        assert getattr(dynid.io, name) is getattr(dynid.logs, name)

@@ -18,7 +18,7 @@ import dynid
 from dynid.export.result_files import load_result, save_result
 from dynid.identification.identify import RankDeficientError
 from dynid.identification.log_identification import identify_log, validate_log
-from dynid.io import Log
+from dynid.logs import Log
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -203,7 +203,7 @@ def test_bad_input(lwr, lwr_result):
     log = fourier_log(lwr, 2, seconds=2.0)
     with pytest.raises(ValueError, match="log: has 7 joints, but the model 'PUMA 560' has 6"):
         identify_log(log, dynid.models.puma560())
-    with pytest.raises(ValueError, match=r"log: expected a dynid.io.Log"):
+    with pytest.raises(ValueError, match=r"log: expected a dynid.Log"):
         identify_log(log.q, lwr)
     with pytest.raises(ValueError, match="method"):
         identify_log(log, lwr, method="lasso")

@@ -22,7 +22,7 @@ import pytest
 import dynid
 from dynid.cli import main
 from dynid.export.output_folder import check_output_path, output_folder
-from dynid.io import save_log
+from dynid.logs import save_log
 from output_writer import content
 from test_log_identification import fourier_log
 

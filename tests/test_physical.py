@@ -22,7 +22,7 @@ import dynid
 from dynid.identification.identify import least_squares
 from dynid.identification.log_identification import identify_log
 from dynid.identification.physical import PhysicalIdentificationError, physical_least_squares
-from dynid.io import Log
+from dynid.logs import Log
 from dynid.model.model_files import save_model
 from dynid.model.pseudo_inertia import (
     nearest_with_margin,

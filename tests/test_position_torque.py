@@ -19,7 +19,7 @@ from dynid.identification.position_torque import (
     position_names,
     position_torque_joints,
 )
-from dynid.io import Log
+from dynid.logs import Log
 from test_log_identification import fourier_log
 
 KS = np.array([0.3, 0.0, -0.2, 0.5, 0.1, -0.4, 0.35])

@@ -20,7 +20,7 @@ import pytest
 
 import dynid
 from dynid.identification.log_identification import identify_log, validate_log
-from dynid.io import Log, load_log
+from dynid.logs import Log, load_log
 from dynid.model.model_files import load_model
 
 DATA = Path(__file__).parent / "data"

@@ -348,7 +348,7 @@ def torques_from_currents(result: LogIdentification, log: Log) -> Log:
             "its logs must hold torques"
         )
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
     gains = np.asarray(report["gains"], dtype=float)
     if log.n != gains.size:
         raise ValueError(f"log: has {log.n} joints, the result's gains {gains.size}")

@@ -1,9 +1,9 @@
 """Identification from a measurement log: the Python side of ``dynid identify`` and ``validate``.
 
-A log (``dynid.io``) and a robot model in, an identified torque model out (lecture, "Least
+A log (``dynid.logs``) and a robot model in, an identified torque model out (lecture, "Least
 Squares (LS) identification" and "Additional remarks", Robotics 2 pp. 26-28):
 
-1. the log is prepared (``dynid.io.prepare_log``: filtering, differentiation, decimation, sample
+1. the log is prepared (``dynid.prepare_log``: filtering, differentiation, decimation, sample
    removal; each step only when asked, each in ``log.notes``);
 2. the regressor Y(q, qd, qdd) of every sample is computed in one batch call (C++), with the
    rotor (Ia) and symmetric friction (Fv, Fs) columns when asked, and reduced to the base
@@ -70,7 +70,7 @@ DEFAULT_PRIOR_WEIGHT = 1e-5
 #: Samples per regressor chunk folded into the least-squares factors.
 STREAM_CHUNK = 8192
 
-#: The options of dynid.io.prepare_log that ``preparation`` may hold.
+#: The options of dynid.prepare_log that ``preparation`` may hold.
 PREPARATION = (
     "cutoff",
     "order",
@@ -307,7 +307,7 @@ def identify_log(
 ) -> LogIdentification:
     """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
 
-    ``preparation``: options of :func:`dynid.io.prepare_log` (cutoff, order, differentiate,
+    ``preparation``: options of :func:`dynid.prepare_log` (cutoff, order, differentiate,
     decimate, min_velocity, outlier_k) applied first; qd and qdd are computed from q when the log
     lacks them. ``rotor`` adds the Ia columns; ``friction`` the friction model: False ("none"),
     True or "symmetric" (Fv qd + Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a
@@ -338,7 +338,7 @@ def identify_log(
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
     if not isinstance(robot, Robot):
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
@@ -403,7 +403,7 @@ def identify_log(
         asymmetric_friction=asymmetric,
         _robot=robot,
     )
-    # The regressor chunk by chunk into the least-squares factors (dynid.streaming): memory
+    # The regressor chunk by chunk into the least-squares factors (dynid.identification.streaming): memory
     # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
     chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
     accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
@@ -577,7 +577,7 @@ def _options(preparation: Mapping[str, Any] | None) -> dict[str, Any]:
     if unknown:
         raise ValueError(
             f"preparation: unknown option(s) {unknown}; expected some of "
-            f"{', '.join(PREPARATION)} (dynid.io.prepare_log)"
+            f"{', '.join(PREPARATION)} (dynid.prepare_log)"
         )
     return options
 
@@ -594,7 +594,7 @@ def _plain(value: Any) -> Any:
 
 def _with_derivatives(log: Log, n: int, name: str) -> Log:
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
     if log.n != n:
         raise ValueError(f"log: has {log.n} joints, but the model {name!r} has {n}")
     if log.qd is None or log.qdd is None:

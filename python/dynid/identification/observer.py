@@ -1,7 +1,7 @@
 """Collision residual over a log: the generalized-momentum observer (De Luca & Mattone 2005;
 SPEC §8; the paper's conclusion) run on recorded (q, qd, tau), and its plot.
 
-:class:`dynid.MomentumObserver` (C++) does the work; this module feeds it a :class:`dynid.io.Log`
+:class:`dynid.MomentumObserver` (C++) does the work; this module feeds it a :class:`dynid.Log`
 and a model, either a :class:`dynid.Robot` or an identified :class:`dynid.LogIdentification`
 (its base parameters turned into an equivalent robot: :func:`robot_from_identification`), and
 summarises the residual per joint. Without contact the residual is the model error seen through
@@ -87,7 +87,7 @@ def residual_from_log(model: Robot | LogIdentification, log: Log, gain: float | 
     else:
         robot, _ = robot_from_identification(model)
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
     if log.n != robot.n:
         raise ValueError(f"log: has {log.n} joints, the model {robot.n}")
     log.check_uniform("the momentum observer")

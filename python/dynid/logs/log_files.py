@@ -514,7 +514,7 @@ def save_log(log: Log, path: PathLike) -> None:
     ``# note:`` lines in CSV) and come back on loading.
     """
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
     path = Path(path)
     suffix = path.suffix.lower()
     present = [name for name in SIGNALS if getattr(log, name) is not None]

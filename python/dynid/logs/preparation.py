@@ -1,7 +1,7 @@
 """Preparing a log for identification: the signal processing of :func:`prepare_log`.
 
 :func:`prepare_log` applies the steps of :mod:`dynid.logs.signal` that the identification needs to a
-:class:`dynid.io.Log` (spike removal, zero-phase low-pass, differentiation, decimation, outlier
+:class:`dynid.Log` (spike removal, zero-phase low-pass, differentiation, decimation, outlier
 and near-zero-velocity removal), each step only when asked and each recorded in ``Log.notes``.
 """
 
@@ -68,7 +68,7 @@ def prepare_log(
     Sample removals come last because filters, derivatives and decimation need the uniform grid.
     """
     if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.io.Log, got {type(log).__name__}")
+        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
     if differentiate not in ("missing", "always", "never"):
         raise ValueError(
             f"differentiate: expected 'missing', 'always' or 'never', got {differentiate!r}"

@@ -194,7 +194,7 @@ def differentiate(
     samples use one-sided second-order formulas (``edge_order=2``) when there are at least three
     samples. Differentiation amplifies noise in proportion to frequency, so low-pass as the
     paper does for its eq. 33 experiment; filtering the input rather than the result gives the
-    same middle and quieter ends (see :func:`dynid.io.prepare_log`).
+    same middle and quieter ends (see :func:`dynid.prepare_log`).
     """
     arr = _array(x, "x")
     ax = _axis(arr, axis)
@@ -289,7 +289,7 @@ def moving_mask_min_velocity(
     per_joint
         False (default): a (T,) mask, True where EVERY joint has |qd_j| >= threshold_j, i.e. a
         sample is dropped when any joint is slow; this is what selecting whole samples (rows
-        t_k of a log, as :func:`dynid.io.prepare_log` does) needs. True: the (T, n) mask of each
+        t_k of a log, as :func:`dynid.prepare_log` does) needs. True: the (T, n) mask of each
         joint separately, for selecting rows of the stacked regressor joint by joint (the
         friction of joint j appears only in joint j's rows), which keeps more data.
     """
