@@ -1,4 +1,5 @@
-"""identify_drive_gains (dynid.identification.drive_gains): drive gains and base parameters from motor currents.
+"""identify_drive_gains (dynid.identification.drive_gains): drive gains and base parameters from
+motor currents.
 
 The runs are exact: currents i = tau / k_true with tau from Pinocchio's RNEA of the KUKA LWR-IV
 model written as URDF (plus dynid's rotor inertia and friction terms, which URDF does not carry

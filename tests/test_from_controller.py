@@ -1,4 +1,5 @@
-"""The paper's identification from the controller's numeric M(q) and g(q) (dynid.identification.from_controller).
+"""The paper's identification from the controller's numeric M(q) and g(q)
+(dynid.identification.from_controller).
 
 Gaz, Flacco, De Luca, ICRA 2014, Sect. V (eqs. (17)-(26)) and Sect. VI (joint 1's gravity row
 dropped, the identically zero element M_76, eq. (27), the symbolic gravity coefficients (28)).

@@ -1,4 +1,5 @@
-"""dynid.logs (and its 0.2 name dynid.io): file formats, round trips, the real KUKA LWR4+ log, malformed files, prepare_log."""
+"""dynid.logs (and its 0.2 name dynid.io): file formats, round trips, the real KUKA LWR4+ log,
+malformed files, prepare_log."""
 
 from __future__ import annotations
 

@@ -15,9 +15,9 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "python" / "dynid"
 
-#: The layers, lowest first (docs/architecture.md). A top-level part (a module or a subpackage) may import its own
-#: subpackage and the parts of lower layers only; parts of one layer are peers that never import
-#: each other (a simulation needs no log reader, a log reader no trajectory).
+#: The layers, lowest first (docs/architecture.md). A top-level part (a module or a subpackage)
+#: may import its own subpackage and the parts of lower layers only; parts of one layer are peers
+#: that never import each other (a simulation needs no log reader, a log reader no trajectory).
 LAYERS: list[set[str]] = [
     {"_core", "_checks", "_equality", "_threads", "_version", "errors", "cmake"},
     {"model"},

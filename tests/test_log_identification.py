@@ -1,4 +1,5 @@
-"""identify_log / validate_log / save and load (dynid.identification.log_identification, dynid.export.result_files).
+"""identify_log / validate_log / save and load (dynid.identification.log_identification,
+dynid.export.result_files).
 
 The synthetic logs are exact: torques from the robot's RNEA (rigid body, rotor inertia, viscous
 and Coulomb friction), positions, velocities and accelerations from a Fourier series in closed

@@ -1,4 +1,4 @@
-"""Model files (dynid.model.model_files): round trips, the LWR4+ tables against pinocchio, errors."""
+"""Model files (dynid.model.model_files): round trips, the LWR4+ tables against Pinocchio."""
 
 from __future__ import annotations
 

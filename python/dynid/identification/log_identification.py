@@ -403,8 +403,9 @@ def identify_log(
         asymmetric_friction=asymmetric,
         _robot=robot,
     )
-    # The regressor chunk by chunk into the least-squares factors (dynid.identification.streaming): memory
-    # bounded by a chunk whatever the log's length; a second pass predicts the torques below.
+    # The regressor chunk by chunk into the least-squares factors
+    # (dynid.identification.streaming): memory bounded by a chunk whatever the log's length; a
+    # second pass predicts the torques below.
     chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
     accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
     for c in chunks:
