@@ -25,6 +25,7 @@ from .._checks import count, is_integer, real_array
 from .._equality import ValueEquality
 from . import signal as sig
 from .columns import check_columns, matching, time_scale
+from .messages import name_list, quote
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
@@ -322,7 +323,7 @@ def _mapped_arrays(
                 else "one (T, n) array or 1-D columns, one per joint"
             )
             raise ValueError(
-                f"columns: {pattern!r} for {signal} matches {', '.join(found)}; expected {expected}"
+                f"columns: {pattern!r} for {signal} matches {name_list(found)}; expected {expected}"
             )
     return arrays
 
@@ -357,7 +358,7 @@ def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
         if name not in arrays:
             alias = NPZ_KEYS[name][1]
             raise ValueError(
-                f"missing key {name!r} (or FloBaRoID {alias!r}); found keys: {', '.join(found)}"
+                f"missing key {name!r} (or FloBaRoID {alias!r}); found keys: {name_list(found)}"
             )
     for name, arr in arrays.items():
         if arr.dtype.kind not in "iuf":
@@ -398,6 +399,20 @@ def _check_npz_members(path: Path) -> None:
 _CSV_COLUMN = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
 
 
+def _check_comma_separated(header: list[str], line: int) -> None:
+    """Refuse a header that is one column of names separated by blanks (a UR RTDE recording,
+    a MATLAB or spreadsheet export with another delimiter): dynid's CSV logs are comma-separated
+    (docs/data.md)."""
+    if len(header) != 1:
+        return
+    names = header[0].split()
+    if len(names) > 1:
+        raise ValueError(
+            f"line {line}: the header is one column of {len(names)} names separated by blanks "
+            f"({name_list(names)}); CSV logs are comma-separated (docs/data.md)"
+        )
+
+
 def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str]]:
     """(header, values, line number of each data row, notes) of a CSV log."""
     header: list[str] | None = None
@@ -415,6 +430,7 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
             if header is None:
                 header = [f.strip() for f in next(csv.reader([text]))]
                 header_line = number
+                _check_comma_separated(header, header_line)
             else:
                 data.append(text)
                 lines.append(number)
@@ -442,7 +458,8 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
                 values[r, c] = float(field_text)
             except ValueError:
                 raise ValueError(
-                    f"line {lines[r]}, column {header[c]!r}: cannot read {field_text!r} as a number"
+                    f"line {lines[r]}, column {quote(header[c])}: "
+                    f"cannot read {quote(field_text)} as a number"
                 ) from None
     return header, values, lines, notes
 
@@ -456,21 +473,21 @@ def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
         note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
         return Log(**arrays, source=str(path), notes=[*notes, note])
     if "t" not in index:
-        raise ValueError(f"missing column 't'; found columns: {', '.join(header)}")
+        raise ValueError(f"missing column 't'; found columns: {name_list(header)}")
     groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
     for name, c in index.items():
         match = _CSV_COLUMN.match(name)
         if match:
             groups[match.group(1)][int(match.group(2))] = c
     if not groups["q"]:
-        raise ValueError(f"missing columns q1..qn; found columns: {', '.join(header)}")
+        raise ValueError(f"missing columns q1..qn; found columns: {name_list(header)}")
     n = max(groups["q"])
     arrays = {"t": values[:, index["t"]]}
     for name, columns in groups.items():
         if not columns:
             if name == "tau":
                 raise ValueError(
-                    f"missing columns tau1..tau{n}; found columns: {', '.join(header)}"
+                    f"missing columns tau1..tau{n}; found columns: {name_list(header)}"
                 )
             continue
         wanted = range(1, n + 1)
@@ -480,7 +497,7 @@ def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
             problem = f"missing {', '.join(missing)}" if missing else f"extra {', '.join(extra)}"
             raise ValueError(
                 f"inconsistent joint columns: expected {name}1..{name}{n} (n = {n} from column "
-                f"q{n}), {problem}; found columns: {', '.join(header)}"
+                f"q{n}), {problem}; found columns: {name_list(header)}"
             )
         arrays[name] = values[:, [columns[j] for j in wanted]]
     line_numbers = np.asarray(lines)
