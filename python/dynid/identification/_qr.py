@@ -96,6 +96,31 @@ class GroupedTriangularFactors:
                 R[:, columns] = np.ldexp(R[:, columns], old - new)
         return new
 
+    @classmethod
+    def merged(cls, parts: list[GroupedTriangularFactors]) -> GroupedTriangularFactors:
+        """The factors of all the rows of ``parts`` (same n, p and joints): each part's R_j
+        brought to the common power-of-two units (exact), stacked and factored once more, since
+        the R of stacked blocks is the R of their stacked R's."""
+        first = parts[0]
+        whole = cls(first.n, first.p, first.joints)
+        whole.a_exp = max((f.a_exp for f in parts if f.a_exp is not None), default=None)
+        whole.b_exp = max((f.b_exp for f in parts if f.b_exp is not None), default=None)
+        whole.samples = sum(f.samples for f in parts)
+        whole.max_a = max(f.max_a for f in parts)
+        whole.max_b = max(f.max_b for f in parts)
+        p = first.p
+        for j in first.joints:
+            blocks = []
+            for f in parts:
+                R = f.factors[j].copy()
+                if f.a_exp is not None and whole.a_exp is not None:
+                    R[:, :p] = np.ldexp(R[:, :p], f.a_exp - whole.a_exp)
+                if f.b_exp is not None and whole.b_exp is not None:
+                    R[:, p] = np.ldexp(R[:, p], f.b_exp - whole.b_exp)
+                blocks.append(R)
+            whole.factors[j] = upper_triangle(np.vstack(blocks))
+        return whole
+
     def combined(self, weights: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The R of the whole stacked [A | b], joint j's rows multiplied by weights[k] (k-th
         kept joint); (p + 1) x (p + 1), or fewer rows when there are fewer stacked rows."""

@@ -46,6 +46,7 @@ unexcited unknowns), whatever the method.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Union
@@ -67,6 +68,7 @@ from .drive_gain_system import (
     total_least_squares,
     visible_payload,
 )
+from .gain_consistency import BLOCKS, block_edges, jackknife_std, overconfidence
 from .identify import RankDeficientError, relative_std, solve_factors
 from .log_identification import (
     OFFSET_NAME,
@@ -248,10 +250,15 @@ def identify_drive_gains(
             b = -(Yn @ known)
         return A, b
 
-    factors = GroupedTriangularFactors(n, len(unknowns), tuple(range(n)))
+    # Factors per contiguous block of each run (for the jackknife check below), then merged.
+    blocks = []
     for loaded_run, log in runs:
-        for start in range(0, log.T, STREAM_CHUNK):
-            factors.add(*system(log, loaded_run, slice(start, start + STREAM_CHUNK)))
+        for lo, hi in block_edges(log.T, max(2, -(-BLOCKS // len(runs)))):
+            block = GroupedTriangularFactors(n, len(unknowns), tuple(range(n)))
+            for start in range(lo, hi, STREAM_CHUNK):
+                block.add(*system(log, loaded_run, slice(start, min(start + STREAM_CHUNK, hi))))
+            blocks.append(block)
+    factors = GroupedTriangularFactors.merged(blocks)
     try:
         fit = solve_factors(
             factors,
@@ -274,6 +281,25 @@ def identify_drive_gains(
     else:
         x, covariance = fit.theta, fit.covariance
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+
+    def refit(part: GroupedTriangularFactors) -> NDArray[np.float64]:
+        """The gains from part of the rows, by the same method, started from the whole fit."""
+        if method == "nls":
+            return current_least_squares(part, [x], p)[0][p : p + n]
+        if method == "tls":
+            return total_least_squares(part)[0][p : p + n]
+        solved = solve_factors(
+            part, method=method, names=unknowns, on_rank_deficient="raise",
+            rank_tolerance=RANK_TOLERANCE, excluded=(),
+        )  # fmt: skip
+        return solved.theta[p : p + n]
+
+    gains_spread = jackknife_std(blocks, refit)
+    warning = overconfidence(
+        unknowns[p : p + n], x[p : p + n], std[p : p + n], gains_spread, method
+    )
+    if warning is not None:
+        warnings.warn(warning, UserWarning, stacklevel=2)
 
     # Per-run residuals and the torque model's fit on the unloaded runs (k i as the measurement).
     gains = x[p : p + n]
@@ -317,6 +343,8 @@ def identify_drive_gains(
     result.drive_gains = {
         "gains": gains.tolist(),
         "gains_std": std[p : p + n].tolist(),
+        # the block jackknife's (gain_consistency): None when leaving a block out fixes nothing
+        "gains_std_blocks": None if gains_spread is None else gains_spread.tolist(),
         "method": method,
         "payload": dict(zip(PAYLOAD_NAMES, payload_values.tolist())),
         "payload_std": dict(zip(PAYLOAD_NAMES, [_finite(s) for s in payload_std])),
