@@ -5,7 +5,7 @@ The standard deviations of :func:`dynid.identify_drive_gains` come from the fit'
 right when the model holds and the current noise is white. A torque the model misses (friction
 near zero velocity, a Stribeck peak, cogging) biases the gains by more than them and leaves no
 trace in them: on a UR5 with Stribeck friction and the default preparation the gains were off
-by 4-8 of their standard deviations (docs/drive_gains.md, "Checking the standard deviations").
+by up to 7 of their standard deviations (docs/drive_gains.md, "Checking the standard deviations").
 Residual whiteness tests did not see it: the missing torque is smooth along the motion.
 
 The block jackknife (Kuensch, Ann. Statist. 17(3), 1989) estimates the gains again without each
@@ -34,8 +34,8 @@ from .identify import RankDeficientError
 BLOCKS = 8
 #: std_J / std above which the reported deviations are called overconfident. With 8 blocks
 #: std_J has 7 degrees of freedom: under a correct model the ratio exceeds 3 with probability
-#: below 1e-9 (chi-square); measured on simulated UR5 and LWR runs with the true friction model,
-#: it stayed below 2.3, and with unmodelled Stribeck friction it was 3.2-8.5.
+#: below 1e-9 (chi-square); measured on simulated UR5 runs with the true friction model it was
+#: 0.8-2.3, with unmodelled Stribeck friction 3.1-9.4 (docs/drive_gains.md).
 RATIO_LIMIT = 3.0
 #: A spread below this fraction of the estimate is rounding (noise-free data: both deviations
 #: are ~1e-13 relative and their ratio means nothing).
