@@ -39,7 +39,7 @@ def _pose(angle: float, offset: list[float]) -> np.ndarray:
 def _links() -> np.ndarray:
     """Physically consistent standard parameters of three links (Steiner from the CoM)."""
     rows = []
-    for i, (m, com) in enumerate([(2.0, [0.1, -0.05, 0.2]), (1.5, [0.0, 0.1, -0.1]),
+    for i, (m, com) in enumerate([(2.0, [0.1, -0.05, 0.2]), (1.5, [0.03, 0.1, -0.1]),
                                   (0.8, [0.05, 0.02, 0.03])]):  # fmt: skip
         c = np.array(com)
         inertia = np.diag([0.03, 0.04, 0.05]) * (i + 1) + 0.002 * (np.ones((3, 3)) - np.eye(3))
@@ -250,3 +250,14 @@ def test_table_is_well_formed() -> None:
         robot_fields.RobotField("x", "array", (), "nowhere", "", "title")
     with pytest.raises(ValueError, match="group"):
         robot_fields.copy_group(_robot(), _robot(), "structure")
+
+
+def test_table_lists_every_property_of_the_model() -> None:
+    """The binding's Model properties are the table's fields (and n): a field added to the C++
+    Model but not to the table would be missed by copies, pickles and files."""
+    from dynid import _core
+
+    properties = {k for k, v in vars(_core.Model).items() if isinstance(v, property)}
+    settable = {k for k in properties if getattr(_core.Model, k).fset is not None}
+    assert properties == {f.attribute for f in robot_fields.FIELDS} | {"n"}
+    assert settable == {f.attribute for f in robot_fields.SETTABLE}

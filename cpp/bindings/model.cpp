@@ -135,8 +135,7 @@ void bind_model(py::module_& m) {
           "name", [](const PyModel& self) { return self.model->name(); },
           [](PyModel& self, py::handle value) {
             if (!py::isinstance<py::str>(value))
-              throw py::value_error("name: expected a string, got " +
-                                    std::string(py::repr(value)));
+              throw py::value_error("name: expected a string, got " + std::string(py::repr(value)));
             std::string name = value.cast<std::string>();
             self.modify([&](Model& model) { model.set_name(std::move(name)); });
           },
