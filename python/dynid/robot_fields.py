@@ -1,11 +1,12 @@
 """The robot's fields, listed once.
 
 Every field of a :class:`dynid.Robot` is held by the C++ Model (``cpp/include/dynid/model.hpp``,
-a property of ``dynid._core.Model``); the Python class keeps no state of its own. ``FIELDS`` says
-for each field what the workflow around the model needs to know, and everything that goes over
-all of the robot's fields is derived from it:
+a property of ``dynid._core.Model``); the Python class keeps no state of its own, only derived
+caches (the base parameters). ``FIELDS`` says for each field what the workflow around the model
+needs to know, and everything that goes over all of the robot's fields is derived from it:
 
-- copies, pickles and equality (:mod:`dynid.robot`: ``state``, ``restore``, ``equal``);
+- copies, pickles and equality (:mod:`dynid.robot`, through ``state``, ``restore`` and ``equal``
+  below);
 - model files and the model record of result files (:mod:`dynid.io.model_files`);
 - the cache key of the base-parameter structure (:mod:`dynid.base_parameters`);
 - ``dynid info`` (:mod:`dynid.summary`);
