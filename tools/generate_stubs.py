@@ -124,6 +124,8 @@ SETTER_TYPES: dict[str, str] = {
     "Fv": ARRAY_LIKE,
     "Fs": ARRAY_LIKE,
     "transmission": f"{ARRAY_LIKE} | None",
+    "name": "str",
+    "qlim": ARRAY_LIKE,
     "forgetting": "float",
     "max_variance": "float | None",
 }

@@ -132,6 +132,31 @@ void bind_model(py::module_& m) {
                                                                                        : "modified";
                              })
       .def_property(
+          "name", [](const PyModel& self) { return self.model->name(); },
+          [](PyModel& self, py::handle value) {
+            if (!py::isinstance<py::str>(value))
+              throw py::value_error("name: expected a string, got " + std::string(py::repr(value)));
+            std::string name = value.cast<std::string>();
+            self.modify([&](Model& model) { model.set_name(std::move(name)); });
+          },
+          "A label for printing; '<n>-dof arm' by default.")
+      .def_property(
+          "qlim",
+          [](const PyModel& self) {
+            const RowMajorMatrixX limits = self.model->joint_limits();
+            return read_only(limits.data(), {self.model->n(), 2});
+          },
+          [](PyModel& self, py::handle value) {
+            const int n = self.model->n();
+            Array a = parse_fixed(value, "qlim", {n, 2});
+            const MatrixX limits = Eigen::Map<const RowMajorMatrixX>(a.data(), n, 2);
+            // std::invalid_argument (a lower limit not below its upper) reaches Python as a
+            // ValueError.
+            self.modify([&](Model& model) { model.set_joint_limits(limits); });
+          },
+          "Joint limits (n, 2), rows [lower, upper]; default (-pi, pi) for revolute and (-1, 1) m "
+          "for prismatic joints. ValueError naming qlim unless finite with lower < upper.")
+      .def_property(
           "gravity_vector",
           [](const PyModel& self) { return vector_property(self.model->gravity()); },
           [](PyModel& self, py::handle g) {

@@ -4,9 +4,12 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace dynid {
 namespace {
+
+constexpr double kPi = 3.141592653589793;  // the double nearest pi (numpy.pi)
 
 void require_homogeneous(const Matrix4& T, const char* name) {
   if (!T.allFinite()) throw std::invalid_argument(std::string(name) + ": non-finite value");
@@ -46,6 +49,12 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   set_gravity(gravity);
   set_base(base);
   set_tool(tool);
+  name_ = std::to_string(n_) + "-dof arm";
+  qlim_.resize(n_, 2);
+  for (int i = 0; i < n_; ++i) {
+    const double limit = rows_[i].type == JointType::Revolute ? kPi : 1.0;
+    qlim_.row(i) << -limit, limit;
+  }
   parameters_ = MatrixX::Zero(n_, 10);
   Ia_ = VectorX::Zero(n_);
   Fv_ = VectorX::Zero(n_);
@@ -99,6 +108,19 @@ void Model::set_tool(const Matrix4& tool) {
   require_homogeneous(tool, "tool");
   tool_ = tool;
   if (!offsets_.empty()) update_frames();
+}
+
+void Model::set_name(std::string name) { name_ = std::move(name); }
+
+void Model::set_joint_limits(const Eigen::Ref<const MatrixX>& qlim) {
+  if (qlim.rows() != n_ || qlim.cols() != 2)
+    throw std::invalid_argument("qlim: expected shape (" + std::to_string(n_) + ", 2), got (" +
+                                std::to_string(qlim.rows()) + ", " + std::to_string(qlim.cols()) +
+                                ")");
+  if (!qlim.allFinite()) throw std::invalid_argument("qlim: non-finite value");
+  if (!(qlim.col(0).array() < qlim.col(1).array()).all())
+    throw std::invalid_argument("qlim: every lower limit must be below its upper limit");
+  qlim_ = qlim;
 }
 
 void Model::update_frames() {

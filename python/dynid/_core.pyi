@@ -326,12 +326,26 @@ class Model:
         Degrees of freedom.
         """
     @property
+    def name(self) -> str:
+        """
+        A label for printing; '<n>-dof arm' by default.
+        """
+    @name.setter
+    def name(self, arg1: str) -> None: ...
+    @property
     def params(self) -> numpy.typing.NDArray[numpy.float64]:
         """
         Standard inertial parameters (n, 10): [m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] per link, about the origin of DH frame i. Accepts (n, 10) or (10n,).
         """
     @params.setter
     def params(self, arg1: numpy.typing.ArrayLike) -> None: ...
+    @property
+    def qlim(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Joint limits (n, 2), rows [lower, upper]; default (-pi, pi) for revolute and (-1, 1) m for prismatic joints. ValueError naming qlim unless finite with lower < upper.
+        """
+    @qlim.setter
+    def qlim(self, arg1: numpy.typing.ArrayLike) -> None: ...
     @property
     def tool(self) -> numpy.typing.NDArray[numpy.float64]:
         """

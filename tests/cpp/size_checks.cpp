@@ -199,6 +199,11 @@ int main() {
   expect_rejected("Model", "params", [&] { editable.set_parameters(MatrixX::Zero(n, 9)); }, false);
   expect_rejected("Model", "i", [&] { editable.set_link(n, dynid::RigidBodyParameters()); }, false);
   expect_rejected("Model", "i", [&] { (void)editable.link_inconsistency(-1); }, false);
+  expect_rejected("Model", "qlim", [&] { editable.set_joint_limits(MatrixX::Zero(n, 3)); }, false);
+  MatrixX reversed(n, 2);
+  reversed.col(0).setOnes();
+  reversed.col(1).setZero();
+  expect_rejected("Model", "qlim", [&] { editable.set_joint_limits(reversed); }, false);
   dynid::RecursiveLeastSquares rls(4);
   const MatrixX block = MatrixX::Ones(2, 4);
   expect_rejected(

@@ -1,6 +1,8 @@
-// The description of a serial arm: its DH table, gravity, base and tool transforms, standard
-// inertial parameters (SPEC section 2) and drive terms. Every per-call buffer lives in a
-// Workspace, so one Model serves many threads.
+// The description of a serial arm: its name, DH table, gravity, base and tool transforms, joint
+// limits, standard inertial parameters (SPEC section 2) and drive terms. This is the whole robot:
+// the Python Robot keeps no state of its own, and python/dynid/robot_fields.py lists these fields
+// once for copies, pickles, equality, model and result files and `dynid info`. Every per-call
+// buffer lives in a Workspace, so one Model serves many threads.
 //
 // Mutability and threads. A Model is a value: it is built from a DH table and completed with the
 // setters below (set_link, set_parameters, set_rotor_inertia, ...), each of which checks its
@@ -52,6 +54,17 @@ class Model {
   void set_gravity(const Vector3& gravity);
   void set_base(const Matrix4& base);
   void set_tool(const Matrix4& tool);
+
+  // A label for printing ("<n>-dof arm" by default). Any text.
+  const std::string& name() const { return name_; }
+  void set_name(std::string name);
+
+  // Joint limits, n x 2 rows [lower, upper] (rad or m): (-pi, pi) for a revolute and (-1, 1) m
+  // for a prismatic joint by default. Data for the user of the model (random configurations,
+  // excitation, bounds); no algorithm reads them. set_joint_limits throws std::invalid_argument
+  // naming `qlim` unless the matrix is n x 2, finite and every lower limit is below its upper.
+  const MatrixX& joint_limits() const { return qlim_; }
+  void set_joint_limits(const Eigen::Ref<const MatrixX>& qlim);
 
   // Standard parameters, n x 10, row i about the origin of DH frame i (SPEC order).
   const MatrixX& parameters() const { return parameters_; }
@@ -110,6 +123,8 @@ class Model {
   std::vector<DHRow> rows_;
   Vector3 gravity_;
   Matrix4 base_, tool_;
+  std::string name_;
+  MatrixX qlim_;
   MatrixX parameters_;
   VectorX Ia_, Fv_, Fs_;
   MatrixX T_, drive_inertia_, drive_damping_;

@@ -3,10 +3,14 @@ drive terms and the base-parameter counts of SPEC section 3)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
+from ..model import robot_fields
 from ..model.base_parameters import base_parameters
 from ..model.robot import Robot
+from ..model.robot_fields import RobotField
 
 #: What is printed as 0: values below this fraction of the scale they are read against (one part
 #: in 10^9: below anything measured on a robot). URDF imports leave rounding residue (6e-17 rad
@@ -24,47 +28,15 @@ def shown(values: np.ndarray, scale: float) -> np.ndarray:
 def model_summary(robot: Robot) -> str:
     """The DH table with joint limits, base/tool transforms when not the identity, the standard
     parameters per link, the drive terms (with the transmission T when coupled) and the
-    base-parameter counts per regressor kind. Rounding residue is printed as 0 (``shown``)."""
-    lines = [
-        f"{robot.name}: {robot.n} joints ({robot.joint_types}), {robot.convention} DH, "
-        f"gravity {np.round(robot.gravity_vector, 6).tolist()}"
-    ]
-    heads = ("a_{i-1}", "alpha_{i-1}") if robot.convention == "modified" else ("a", "alpha")
-    lines.append(
-        f"  {'row':<4}{'type':<5}{heads[0]:>10}  {heads[1]:>16}  {'d':>10}  "
-        f"{'theta':>10}  {'qmin':>8}  {'qmax':>8}"
-    )
-    # Lengths against the arm's size (1 m at least), angles against one radian.
-    size = max(1.0, float(np.abs(robot.dh[:, [0, 2]]).max(initial=0.0)))
-    for i, (dh, kind, lim) in enumerate(zip(robot.dh, robot.joint_types, robot.qlim)):
-        row = np.where([True, False, True, False], shown(dh, size), shown(dh, 1.0))  # a, d; angles
-        alpha = f"{row[1]:.6g} ({np.degrees(row[1]):.4g}°)"
-        lines.append(
-            f"  {i + 1:<4}{kind:<5}{row[0]:>10.6g}  {alpha:>16}  {row[2]:>10.6g}  "
-            f"{row[3]:>10.6g}  {lim[0]:>8.4g}  {lim[1]:>8.4g}"
-        )
-    for key in ("base", "tool"):
-        value = np.asarray(getattr(robot, key))
-        if not np.array_equal(value, np.eye(4)):
-            lines.append(f"  {key}: {shown(np.round(value, 6), 1.0).tolist()}")
-    params = robot.params
-    lines.append(
-        "parameters (frame-i origin, SPEC order m mx my mz Ixx Ixy Ixz Iyy Iyz Izz); total "
-        f"mass {params[:, 0].sum():.4g} kg, physically consistent: "
-        f"{'yes' if robot.is_physically_consistent() else 'no'}"
-    )
-    for i, row in enumerate(params):
-        # Each quantity against its own kind in this link: mass, first moments, inertias.
-        row = np.concatenate(
-            [shown(row[:1], row[0]), shown(row[1:4], np.abs(row[1:4]).max()),
-             shown(row[4:], np.abs(row[4:]).max())]
-        )  # fmt: skip
-        lines.append(f"  link {i + 1}:" + "".join(f"{v:>11.4g}" for v in row))
-    for key in ("Ia", "Fv", "Fs"):
-        lines.append(f"  {key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, key)))
-    if robot.coupled:
-        lines.append("  transmission T (motor velocities T qd; Ia, Fv, Fs per motor):")
-        lines.extend("    " + " ".join(f"{v:>8.4g}" for v in row) for row in robot.transmission)
+    base-parameter counts per regressor kind. Rounding residue is printed as 0 (``shown``).
+
+    Every field of dynid.model.robot_fields is printed, in the table's order, by its layout
+    (``shown``); fields flagged ``omit_default`` only when they differ from their default."""
+    lines = _title(robot) + _joint_table(robot)
+    fresh = robot_fields.defaults(robot)
+    for field in robot_fields.FIELDS:
+        if not (field.omit_default and robot_fields.is_default(robot, field, fresh)):
+            lines += _LAYOUTS[field.shown](robot, field)
     counts = [
         (label, base_parameters(robot, "torque", rotor=rotor, friction=friction).count)
         for label, rotor, friction in (
@@ -81,3 +53,80 @@ def model_summary(robot: Robot) -> str:
         f"{base_parameters(robot, 'inertia').count}"
     )
     return "\n".join(lines)
+
+
+def _title(robot: Robot) -> list[str]:
+    """The fields shown "title": name, joints, convention and gravity on the first line."""
+    return [
+        f"{robot.name}: {robot.n} joints ({robot.joint_types}), {robot.convention} DH, "
+        f"gravity {np.round(robot.gravity_vector, 6).tolist()}"
+    ]
+
+
+def _joint_table(robot: Robot) -> list[str]:
+    """The DH table (field shown "joint table"), one row per joint, with a column per word of
+    the label of each field shown "joint columns" (qlim: qmin, qmax)."""
+    columns = [f for f in robot_fields.FIELDS if f.shown == "joint columns"]
+    heads = ("a_{i-1}", "alpha_{i-1}") if robot.convention == "modified" else ("a", "alpha")
+    lines = [
+        f"  {'row':<4}{'type':<5}{heads[0]:>10}  {heads[1]:>16}  {'d':>10}  {'theta':>10}"
+        + "".join(f"  {head:>8}" for f in columns for head in f.label.split())
+    ]
+    values = np.column_stack([np.asarray(getattr(robot, f.attribute)) for f in columns])
+    # Lengths against the arm's size (1 m at least), angles against one radian.
+    size = max(1.0, float(np.abs(robot.dh[:, [0, 2]]).max(initial=0.0)))
+    for i, (dh, kind) in enumerate(zip(robot.dh, robot.joint_types)):
+        row = np.where([True, False, True, False], shown(dh, size), shown(dh, 1.0))  # a, d; angles
+        alpha = f"{row[1]:.6g} ({np.degrees(row[1]):.4g}°)"
+        lines.append(
+            f"  {i + 1:<4}{kind:<5}{row[0]:>10.6g}  {alpha:>16}  {row[2]:>10.6g}  "
+            f"{row[3]:>10.6g}" + "".join(f"  {v:>8.4g}" for v in values[i])
+        )
+    return lines
+
+
+def _transform(robot: Robot, field: RobotField) -> list[str]:
+    value = np.asarray(getattr(robot, field.attribute))
+    return [f"  {field.key}: {shown(np.round(value, 6), 1.0).tolist()}"]
+
+
+def _links(robot: Robot, field: RobotField) -> list[str]:
+    params = getattr(robot, field.attribute)
+    lines = [
+        "parameters (frame-i origin, SPEC order m mx my mz Ixx Ixy Ixz Iyy Iyz Izz); total "
+        f"mass {params[:, 0].sum():.4g} kg, physically consistent: "
+        f"{'yes' if robot.is_physically_consistent() else 'no'}"
+    ]
+    for i, row in enumerate(params):
+        # Each quantity against its own kind in this link: mass, first moments, inertias.
+        row = np.concatenate(
+            [shown(row[:1], row[0]), shown(row[1:4], np.abs(row[1:4]).max()),
+             shown(row[4:], np.abs(row[4:]).max())]
+        )  # fmt: skip
+        lines.append(f"  link {i + 1}:" + "".join(f"{v:>11.4g}" for v in row))
+    return lines
+
+
+def _per_joint(robot: Robot, field: RobotField) -> list[str]:
+    return [f"  {field.key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, field.attribute))]
+
+
+def _matrix(robot: Robot, field: RobotField) -> list[str]:
+    rows = getattr(robot, field.attribute)
+    return [f"  {field.label}:"] + ["    " + " ".join(f"{v:>8.4g}" for v in row) for row in rows]
+
+
+def _printed_elsewhere(robot: Robot, field: RobotField) -> list[str]:
+    return []  # in the title or the joint table
+
+
+#: The printer of each layout of dynid.model.robot_fields.LAYOUTS.
+_LAYOUTS: dict[str, Callable[[Robot, RobotField], list[str]]] = {
+    "title": _printed_elsewhere,
+    "joint table": _printed_elsewhere,
+    "joint columns": _printed_elsewhere,
+    "transform": _transform,
+    "links": _links,
+    "per joint": _per_joint,
+    "matrix": _matrix,
+}

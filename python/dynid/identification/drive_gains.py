@@ -214,7 +214,9 @@ def identify_drive_gains(
     unknowns = names + [f"{GAIN_NAME}{j}" for j in range(1, n + 1)]
     unknowns += [PAYLOAD_NAMES[c] for c in estimated]
     result = LogIdentification(
-        model=model_to_dict(robot),
+        # Without the parameters and drive terms: their values were a prior, no part of the
+        # identified model.
+        model=model_to_dict(robot, identified=False),
         rotor=rotor,
         friction=friction,
         offset=offset,
@@ -231,8 +233,6 @@ def identify_drive_gains(
         rank=0,
         _robot=robot,
     )
-    for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
-        result.model.pop(key, None)
 
     def system(log: Log, loaded: bool, c: slice) -> tuple[NDArray, NDArray]:
         """The rows [Y, -diag(i), Y_n,estimated] and right-hand side of samples c of a run."""

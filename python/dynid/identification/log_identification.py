@@ -383,7 +383,9 @@ def identify_log(
         names += more_names
         expressions += more_expressions
     result = LogIdentification(
-        model=model_to_dict(robot),
+        # Without the parameters and drive terms: their values were a prior, no part of the
+        # identified model.
+        model=model_to_dict(robot, identified=False),
         rotor=bool(rotor),
         friction=symmetric,
         offset=bool(offset),
@@ -420,8 +422,6 @@ def identify_log(
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.covariance = fit.covariance
     result.excluded = fit.excluded
-    for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
-        result.model.pop(key, None)
     if physical:
         _physical(result, prepared, fit.noise_variance, prior_robot, prior_weight or 0.0, prior)
     result.training = {

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 from .. import _checks as checks
 from .._equality import ValueEquality
 from .._threads import blas_single_threaded
+from . import robot_fields
 from .robot import Robot
 
 #: A column is independent when, after scaling every column to unit norm, the part of it outside
@@ -92,18 +93,9 @@ def base_parameters(
         raise ValueError("rotor/friction: the gravity regressor has no drive-term columns")
     if kind == "inertia" and friction:
         raise ValueError("friction: the inertia regressor has no friction columns")
-    # Everything the structure depends on (SPEC 3: not the parameter values, nor the limits).
-    key = (
-        kind,
-        bool(rotor),
-        bool(friction),
-        robot.convention,
-        robot.joint_types,
-        robot.dh.tobytes(),
-        robot.gravity_vector.tobytes(),
-        robot.base.tobytes(),
-        robot.transmission.tobytes(),  # couples the drive columns (docs/transmission.md)
-    )
+    # Everything the structure depends on (SPEC 3: not the parameter values, nor the limits):
+    # the fields flagged structural in dynid.model.robot_fields.
+    key = (kind, bool(rotor), bool(friction), *robot_fields.structure_key(robot))
     with _CACHE_LOCK:
         cache = robot.__dict__.setdefault("_base_parameter_cache", OrderedDict())
         found = cache.get(key)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from . import robot_fields
 from .pseudo_inertia import pseudo_inertia, standard_from_pseudo_inertia
 from .robot import Robot
 
@@ -92,6 +93,5 @@ def express_in_frames_of(model: Robot, robot: Robot) -> Robot:
             inverse @ pseudo_inertia(model.params[i]) @ inverse.T
         )
     out.params = params
-    out.Ia, out.Fv, out.Fs = model.Ia, model.Fv, model.Fs
-    out.transmission = model.transmission
+    robot_fields.copy_group(model, out, "drive")
     return out

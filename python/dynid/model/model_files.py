@@ -15,6 +15,10 @@ all revolute), ``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4),
 ``params`` (n x 10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each), ``transmission``
 (n x n coupling matrix T, theta_dot = T qd; docs/transmission.md; absent means identity). Unknown
 fields are errors, so that a misspelt ``gravity`` is not silently replaced by the default.
+
+The fields, their order, which are required and which are left out at their default value come
+from :mod:`dynid.model.robot_fields` (one entry per field of the robot); only the DH rows have a
+format of their own here.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from typing import Any, Union
 import numpy as np
 
 from .._checks import MAX_JOINTS
-from . import models
+from . import models, robot_fields
 from .robot import Robot
 
 PathLike = Union[str, Path]
@@ -45,21 +49,8 @@ BUILTIN_MODELS: dict[str, Callable[[], Robot]] = {
 FORMAT = "dynid-model"
 #: Fields a model file may hold besides the model itself (ignored).
 METADATA = ("format", "version", "description", "notes", "source", "units")
-FIELDS = (
-    "name",
-    "convention",
-    "joint_types",
-    "gravity",
-    "rows",
-    "base",
-    "tool",
-    "qlim",
-    "params",
-    "Ia",
-    "Fv",
-    "Fs",
-    "transmission",
-)
+#: The model's fields in a file, in the order they are written (dynid.model.robot_fields).
+FIELDS = tuple(f.file_key for f in robot_fields.FIELDS)
 #: Row fields: the standard name, then the names accepted for it.
 ROW_NAMES = {
     "standard": {"a": ("a",), "alpha": ("alpha",), "d": ("d",), "theta": ("theta", "theta_offset")},
@@ -69,6 +60,11 @@ ROW_NAMES = {
         "d": ("d",),
         "theta": ("theta", "theta_offset"),
     },
+}
+#: The names model files are written with, per convention (a_{i-1}, alpha_{i-1} in modified DH).
+ROW_KEYS = {
+    "standard": ("a", "alpha", "d", "theta"),
+    "modified": ("a_prev", "alpha_prev", "d", "theta"),
 }
 YAML_SUFFIXES = (".yaml", ".yml")
 
@@ -142,9 +138,10 @@ def model_from_dict(data: Any) -> Robot:
             f"unknown field(s) {', '.join(repr(k) for k in unknown)}{hint}; expected "
             f"{', '.join(FIELDS)}"
         )
-    for key in ("convention", "rows"):
+    required = [f.file_key for f in robot_fields.FIELDS if f.required]
+    for key in required:
         if key not in data:
-            raise ValueError(f"{key}: missing (a model needs 'convention' and 'rows')")
+            raise ValueError(f"{key}: missing (a model needs {' and '.join(map(repr, required))})")
     convention = data["convention"]
     if convention not in ROW_NAMES:
         raise ValueError(f"convention: expected 'standard' or 'modified', got {convention!r}")
@@ -157,69 +154,55 @@ def model_from_dict(data: Any) -> Robot:
         )
     dh = np.array([_row(row, i, convention) for i, row in enumerate(rows)])
     n = len(dh)
-    name = data.get("name")
-    if name is not None and not isinstance(name, str):
-        raise ValueError(f"name: expected a string, got {name!r}")
     joint_types = data.get("joint_types", "R" * n)
     if not isinstance(joint_types, str):
         raise ValueError(f"joint_types: expected a string of R/P letters, got {joint_types!r}")
-    arrays = {
-        key: _numbers(data[key], key, shape)
-        for key, shape in (
-            ("gravity", (3,)),
-            ("base", (4, 4)),
-            ("tool", (4, 4)),
-            ("qlim", (n, 2)),
-            ("params", (n, 10)),
-            ("Ia", (n,)),
-            ("Fv", (n,)),
-            ("Fs", (n,)),
-            ("transmission", (n, n)),
-        )
-        if data.get(key) is not None
+    # Every value is checked for its type and shape before the model is built; the setters then
+    # check what they need (homogeneous transforms, ordered limits, an invertible T).
+    values = {
+        f.attribute: _value(data[f.file_key], f, n)
+        for f in robot_fields.SETTABLE
+        if data.get(f.file_key) is not None
     }
-    robot = Robot.from_dh(
-        dh,
-        joint_types,
-        convention,
-        arrays.get("gravity", (0.0, 0.0, -9.81)),
-        params=arrays.get("params"),
-        base=arrays.get("base"),
-        tool=arrays.get("tool"),
-        qlim=arrays.get("qlim"),
-        name=name,
-    )
-    for key in ("Ia", "Fv", "Fs", "transmission"):
-        if key in arrays:
-            setattr(robot, key, arrays[key])
+    robot = Robot.from_dh(dh, joint_types, convention)
+    for attribute, value in values.items():
+        if value is not None:
+            setattr(robot, attribute, value)
     return robot
 
 
-def model_to_dict(robot: Robot) -> dict[str, Any]:
-    """The content of a model file for ``robot`` (JSON-ready: lists and floats)."""
-    if robot.convention == "modified":
-        keys = ("a_prev", "alpha_prev", "d", "theta")
-    else:
-        keys = ("a", "alpha", "d", "theta")
-    data: dict[str, Any] = {
-        "format": FORMAT,
-        "name": str(getattr(robot, "name", "")),
-        "convention": robot.convention,
-        "joint_types": robot.joint_types,
-        "gravity": _floats(robot.gravity_vector),
-        "rows": [dict(zip(keys, _floats(row))) for row in robot.dh],
-    }
-    for key in ("base", "tool"):
-        value = np.asarray(getattr(robot, key))
-        if not np.array_equal(value, np.eye(4)):
-            data[key] = _floats(value)
-    data["qlim"] = _floats(robot.qlim)
-    data["params"] = _floats(robot.params)
-    for key in ("Ia", "Fv", "Fs"):
-        data[key] = _floats(getattr(robot, key))
-    if robot.coupled:
-        data["transmission"] = _floats(robot.transmission)
+def model_to_dict(robot: Robot, identified: bool = True) -> dict[str, Any]:
+    """The content of a model file for ``robot`` (JSON-ready: lists and floats).
+
+    ``identified=False`` leaves out what identification estimates (the standard parameters and
+    the drive terms Ia, Fv, Fs: the fields flagged ``identified`` in dynid.model.robot_fields): the
+    model record of a least-squares result, whose values of those were only a prior."""
+    fresh = robot_fields.defaults(robot)
+    data: dict[str, Any] = {"format": FORMAT}
+    for f in robot_fields.FIELDS:
+        if (f.identified and not identified) or (
+            f.omit_default and robot_fields.is_default(robot, f, fresh)
+        ):
+            continue
+        value = getattr(robot, f.attribute)
+        if f.kind == "dh":
+            keys = ROW_KEYS[robot.convention]
+            data[f.file_key] = [dict(zip(keys, _floats(row))) for row in value]
+        elif f.kind == "text":
+            data[f.file_key] = str(value)
+        else:
+            data[f.file_key] = _floats(value)
     return data
+
+
+def _value(value: Any, field: robot_fields.RobotField, n: int) -> Any:
+    """A settable field's value from a file: a string, or numbers of the field's shape. An empty
+    text (``"name": ""``) means the default, as an absent one."""
+    if field.kind == "text":
+        if not isinstance(value, str):
+            raise ValueError(f"{field.file_key}: expected a string, got {value!r}")
+        return value or None
+    return _numbers(value, field.file_key, field.shape_for(n))
 
 
 def _row(row: Any, i: int, convention: str) -> list[float]:

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
 from .. import _core
-from . import linearization, operational_space
+from . import linearization, operational_space, robot_fields
 
 PARAMETER_FIELDS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
 
@@ -30,21 +30,11 @@ class Robot(_core.Model):
     ``friction``, ``forward_dynamics``, ``kinetic_energy``, ``potential_energy``, ``fkine``,
     ``jacobian``, and SPEC section 8's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
     ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
-    """
 
-    def __init__(
-        self,
-        dh: ArrayLike,
-        joint_types: str,
-        convention: str = "standard",
-        gravity: ArrayLike = (0.0, 0.0, -9.81),
-        base: ArrayLike | None = None,
-        tool: ArrayLike | None = None,
-    ) -> None:
-        super().__init__(dh, joint_types, convention, gravity, base, tool)
-        self._qlim = _default_limits(self.joint_types)
-        self._qlim.setflags(write=False)
-        self.name = f"{self.n}-dof arm"
+    Every field (``name``, the DH table, gravity, ``base``, ``tool``, ``qlim``, ``params``, the
+    drive terms, ``transmission``) is held by the C++ model; :mod:`dynid.model.robot_fields` lists
+    them once for copies, pickles, equality, files and ``dynid info``.
+    """
 
     @classmethod
     def from_dh(
@@ -177,22 +167,6 @@ class Robot(_core.Model):
             write_urdf(text, path, overwrite)
         return text
 
-    # ---- limits and labels -------------------------------------------------------------------
-    @property
-    def qlim(self) -> NDArray[np.float64]:
-        """Joint limits (n, 2), [lower, upper]."""
-        return self._qlim
-
-    @qlim.setter
-    def qlim(self, value: ArrayLike) -> None:
-        limits = _as_finite(value, "qlim")
-        if limits.shape != (self.n, 2):
-            raise ValueError(f"qlim: expected shape ({self.n}, 2), got {limits.shape}")
-        if np.any(limits[:, 0] >= limits[:, 1]):
-            raise ValueError("qlim: every lower limit must be below its upper limit")
-        limits.setflags(write=False)
-        self._qlim = limits
-
     def __repr__(self) -> str:
         return (
             f"Robot({getattr(self, 'name', '?')!r}, n={self.n}, joints={self.joint_types!r}, "
@@ -245,39 +219,20 @@ class Robot(_core.Model):
         return names
 
     # ---- copies, pickling, equality (multiprocessing, Dask and Ray pickle what they send) -----
+    # All three go over dynid.model.robot_fields.FIELDS, so that they cover every field.
     def _state(self) -> dict[str, Any]:
         """Everything that defines the robot (derived caches such as base parameters excluded)."""
-        return {
-            "dh": self.dh,
-            "joint_types": self.joint_types,
-            "convention": self.convention,
-            "gravity": self.gravity_vector,
-            "params": self.params,
-            "base": self.base,
-            "tool": self.tool,
-            "qlim": self.qlim,
-            "name": self.name,
-            "Ia": self.Ia,
-            "Fv": self.Fv,
-            "Fs": self.Fs,
-            "transmission": self.transmission,
-        }
+        return robot_fields.state(self)
 
     def __reduce__(self) -> tuple[object, tuple[dict[str, Any]]]:
         return (_robot_from_state, (self._state(),))
 
     def __eq__(self, other: object) -> bool:
-        """Same DH table, joint types, convention, gravity, transforms, parameters, drive terms,
-        limits and name (exact comparison)."""
+        """Every field the same (dynid.model.robot_fields: name, DH table, joint types, convention,
+        gravity, transforms, limits, parameters, drive terms, transmission; exact comparison)."""
         if not isinstance(other, Robot):
             return NotImplemented
-        mine, theirs = self._state(), other._state()
-        return all(
-            np.array_equal(mine[k], theirs[k])
-            if isinstance(mine[k], np.ndarray)
-            else mine[k] == theirs[k]
-            for k in mine
-        )
+        return robot_fields.equal(self, other)
 
     # Unhashable (parameters are settable); mypy objects to None in place of the inherited method.
     __hash__ = None  # type: ignore[assignment]
@@ -288,21 +243,8 @@ class Robot(_core.Model):
         return not np.array_equal(self.transmission, np.eye(self.n))
 
     def copy(self) -> Robot:
-        """An independent copy (parameters, drive terms, limits, transforms)."""
-        other = Robot.from_dh(
-            self.dh,
-            self.joint_types,
-            self.convention,
-            self.gravity_vector,
-            self.params,
-            self.base,
-            self.tool,
-            self.qlim,
-            self.name,
-        )
-        other.Ia, other.Fv, other.Fs = self.Ia, self.Fv, self.Fs
-        other.transmission = self.transmission
-        return other
+        """An independent copy (every field of dynid.model.robot_fields)."""
+        return _robot_from_state(self._state())
 
     def with_payload(self, mass: float, com: ArrayLike, inertia: ArrayLike | None = None) -> Robot:
         """A copy carrying a rigid payload on the last link (notes, "Rule of change in dynamic
@@ -346,8 +288,7 @@ class Robot(_core.Model):
         """A copy without drive terms (Ia = Fv = Fs = 0, transmission identity): the links alone,
         e.g. the link equation of an arm with elastic joints (paper eq. (7))."""
         other = self.copy()
-        other.Ia = other.Fv = other.Fs = np.zeros(self.n)
-        other.transmission = None
+        robot_fields.copy_group(robot_fields.defaults(self), other, "drive")
         return other
 
     # ---- uses of the model (SPEC section 8) ---------------------------------------------------
@@ -384,25 +325,10 @@ class Robot(_core.Model):
 
 
 def _robot_from_state(state: dict[str, Any]) -> Robot:
-    """Rebuild a pickled robot (see ``Robot.__reduce__``)."""
-    robot = Robot.from_dh(
-        state["dh"],
-        state["joint_types"],
-        state["convention"],
-        state["gravity"],
-        state["params"],
-        state["base"],
-        state["tool"],
-        state["qlim"],
-        state["name"],
-    )
-    robot.Ia, robot.Fv, robot.Fs = state["Ia"], state["Fv"], state["Fs"]
-    robot.transmission = state.get("transmission")  # absent in pickles from before it existed
+    """Rebuild a pickled robot (see ``Robot.__reduce__``); fields absent from ``state`` (pickled
+    before they existed, e.g. ``transmission``) keep their defaults."""
+    robot: Robot = robot_fields.restore(Robot, state)
     return robot
-
-
-def _default_limits(joint_types: Sequence[str]) -> NDArray[np.float64]:
-    return np.array([(-np.pi, np.pi) if t == "R" else (-1.0, 1.0) for t in joint_types])
 
 
 def _as_finite(value: ArrayLike, name: str) -> NDArray[np.float64]:
