@@ -1,6 +1,9 @@
 // Internal (dynid::detail, not API): the drive terms of SPEC section 2 (rotor inertia, viscous
 // and Coulomb friction) in one place, for every algorithm that adds them (rnea, crba, forward
-// dynamics, energy, friction, the derivatives, the simulator, the regressors).
+// dynamics, energy, friction, the derivatives, the simulator, the regressors), and the friction
+// law itself (friction_law, coulomb_shape), which the elastic joints' motor equation
+// (detail/elastic_motor.hpp) uses too. The SIMD lane kernels (cpp/src/batch/) keep their own
+// per-lane copy: they may share no inline function with the baseline code (batch_model.hpp).
 //
 // Transmission coupling (notes p. 11-13): the motors turn at theta_dot = T qd (after the gears),
 // so the rotor kinetic energy 1/2 theta_dot^T diag(Ia) theta_dot adds T^T diag(Ia) T to M(q)
@@ -11,6 +14,8 @@
 // Nothing here allocates.
 #pragma once
 
+#include <cmath>
+
 #include "dynid/model.hpp"
 
 namespace dynid::detail {
@@ -18,9 +23,19 @@ namespace dynid::detail {
 // sign(0) = 0 (notes, "Adding dynamic terms").
 inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
 
+// The Coulomb term's shape s(w): sign(w) for band = 0 (SPEC section 2), else tanh(w / band), the
+// simulators' smoothing of the jump at w = 0 (an explicit integrator chatters on the exact sign).
+inline double coulomb_shape(double w, double band) {
+  return band > 0.0 ? std::tanh(w / band) : sign(w);
+}
+
+// The friction law of one drive (notes, "Adding dynamic terms"; paper eq. (2) for the motor side
+// of an elastic joint): Fv w + Fs s, with s = sign(w) or coulomb_shape(w, band).
+inline double friction_law(double Fv, double Fs, double w, double s) { return Fv * w + Fs * s; }
+
 // Decoupled joint i: Fv_i qd + Fs_i sign(qd).
 inline double friction_torque(const Model& model, int i, double qd) {
-  return model.viscous_friction()[i] * qd + model.coulomb_friction()[i] * sign(qd);
+  return friction_law(model.viscous_friction()[i], model.coulomb_friction()[i], qd, sign(qd));
 }
 
 // Motor k's share of a joint-space vector: (T v)_k (theta_dot_k for v = qd).
@@ -46,12 +61,33 @@ inline void add_drive_friction(const Model& model, const Qd& qd, Tau& tau, Coulo
   const VectorX& Fv = model.viscous_friction();
   const VectorX& Fs = model.coulomb_friction();
   if (model.transmission_is_identity()) {
-    for (int i = 0; i < model.n(); ++i) tau[i] += Fv[i] * qd[i] + Fs[i] * coulomb(qd[i]);
+    for (int i = 0; i < model.n(); ++i) tau[i] += friction_law(Fv[i], Fs[i], qd[i], coulomb(qd[i]));
     return;
   }
   for (int k = 0; k < model.n(); ++k) {
     const double w = motor_value(model, k, qd);
-    add_motor_torque(model, k, Fv[k] * w + Fs[k] * coulomb(w), tau);
+    add_motor_torque(model, k, friction_law(Fv[k], Fs[k], w, coulomb(w)), tau);
+  }
+}
+
+// The same friction split by term: viscous += T^T (Fv . w), coulomb += T^T (Fs . s(w)), w = T qd,
+// s = coulomb_shape(., band) (what scales with the speed and what does not: time scaling).
+template <class Qd, class Out>
+inline void add_drive_friction_terms(const Model& model, const Qd& qd, double band, Out& viscous,
+                                     Out& coulomb) {
+  const VectorX& Fv = model.viscous_friction();
+  const VectorX& Fs = model.coulomb_friction();
+  if (model.transmission_is_identity()) {
+    for (int i = 0; i < model.n(); ++i) {
+      viscous[i] += friction_law(Fv[i], 0.0, qd[i], 0.0);
+      coulomb[i] += friction_law(0.0, Fs[i], qd[i], coulomb_shape(qd[i], band));
+    }
+    return;
+  }
+  for (int k = 0; k < model.n(); ++k) {
+    const double w = motor_value(model, k, qd);
+    add_motor_torque(model, k, friction_law(Fv[k], 0.0, w, 0.0), viscous);
+    add_motor_torque(model, k, friction_law(0.0, Fs[k], w, coulomb_shape(w, band)), coulomb);
   }
 }
 
@@ -72,7 +108,7 @@ inline void add_drive_torque(const Model& model, const Qd& qd, const Qdd& qdd, T
   const VectorX& Fs = model.coulomb_friction();
   for (int k = 0; k < model.n(); ++k) {
     const double a = motor_value(model, k, qdd), w = motor_value(model, k, qd);
-    add_motor_torque(model, k, Ia[k] * a + (Fv[k] * w + Fs[k] * sign(w)), tau);
+    add_motor_torque(model, k, Ia[k] * a + friction_law(Fv[k], Fs[k], w, sign(w)), tau);
   }
 }
 

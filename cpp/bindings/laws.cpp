@@ -1,0 +1,168 @@
+// Binding of the laws' core functions (laws.hpp): conversions, shape checks and the loop over
+// samples only; the physics is in cpp/src (friction.cpp, elastic_motor.cpp, kinematics.cpp).
+#include "laws.hpp"
+
+#include <pybind11/numpy.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "arrays.hpp"
+#include "dynid/detail/elastic_motor.hpp"
+#include "dynid/elastic_motor.hpp"
+#include "dynid/friction.hpp"
+#include "dynid/kinematics.hpp"
+#include "model.hpp"
+
+namespace dynid::binding {
+namespace {
+
+double band_argument(py::handle obj) {
+  const double band = parse_number(obj, "coulomb_band");
+  if (!(std::isfinite(band) && band >= 0.0))
+    throw py::value_error("coulomb_band: expected a finite value >= 0, got " +
+                          std::to_string(band));
+  return band;
+}
+
+// The four drives of an elastic robot, (n,) each, checked by the core (ValueError naming them).
+ElasticDrives drives_argument(py::handle K, py::handle B, py::handle Fv, py::handle Fs) {
+  const Array stiffness = as_real_array(K, "stiffness");
+  if (stiffness.ndim() != 1 || stiffness.shape(0) < 1)
+    throw py::value_error("stiffness: expected shape (n,) with n >= 1, got " +
+                          shape_string(stiffness));
+  const int n = static_cast<int>(stiffness.shape(0));
+  const auto vector = [n](py::handle obj, const char* name) {
+    const Array a = parse_fixed(obj, name, {n});
+    return VectorX(Eigen::Map<const VectorX>(a.data(), n));
+  };
+  ElasticDrives drives{vector(K, "stiffness"), vector(B, "motor_inertia"),
+                       vector(Fv, "motor_viscous"), vector(Fs, "motor_coulomb")};
+  try {
+    check_elastic_drives(drives, n);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+  return drives;
+}
+
+// kernel(joint i, the inputs' values at (t, i)) -> the output at (t, i), for inputs of one sample
+// (n,) or T samples (T, n), looped in C++ without the GIL; the output has the inputs' shape.
+template <std::size_t N, class Kernel>
+py::array per_joint_law(const ElasticDrives& drives,
+                        std::initializer_list<std::pair<py::handle, const char*>> inputs,
+                        Kernel kernel) {
+  const int n = static_cast<int>(drives.stiffness.size());
+  const Samples s = parse_samples(inputs, n);
+  std::vector<py::ssize_t> shape{n};
+  if (!s.single) shape.insert(shape.begin(), s.count);
+  py::array_t<double> out(shape);
+  double* result = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    std::array<double, N> values{};
+    for (py::ssize_t t = 0; t < s.count; ++t)
+      for (int i = 0; i < n; ++i) {
+        for (std::size_t k = 0; k < N; ++k) values[k] = s.row(k, t, n)[i];
+        result[t * n + i] = kernel(i, values);
+      }
+  }
+  require_finite_result(result, static_cast<py::ssize_t>(out.size()), s.names.c_str());
+  return out;
+}
+
+std::vector<py::ssize_t> by_joint(int n) { return {n}; }
+std::vector<py::ssize_t> two_by_joint(int n) { return {2, n}; }
+std::vector<py::ssize_t> frames_of_links(int n) { return {n, 4, 4}; }
+
+}  // namespace
+
+void bind_laws(py::module_& m) {
+  m.def(
+      "_friction",
+      [](PyModel& self, py::handle qd, py::handle coulomb_band) {
+        const double band = band_argument(coulomb_band);
+        const int n = self.model->n();
+        return evaluate(
+            self, parse_samples({{qd, "qd"}}, n), by_joint(n),
+            [n, band](const Model& model, Workspace&, const double* const* in, double* tau) {
+              friction(model, ConstVec(in[0], n), band, OutVec(tau, n));
+            });
+      },
+      py::arg("model"), py::arg("qd"), py::arg("coulomb_band"),
+      "Drive friction T^T (Fv w + Fs s(w)), w = T qd, s = tanh(. / coulomb_band) (sign for 0): "
+      "(n,) or (T, n) like qd.");
+  m.def(
+      "_friction_terms",
+      [](PyModel& self, py::handle qd, py::handle coulomb_band) {
+        const double band = band_argument(coulomb_band);
+        const int n = self.model->n();
+        return evaluate(
+            self, parse_samples({{qd, "qd"}}, n), two_by_joint(n),
+            [n, band](const Model& model, Workspace&, const double* const* in, double* terms) {
+              friction_terms(model, ConstVec(in[0], n), band, OutVec(terms, n),
+                             OutVec(terms + n, n));
+            });
+      },
+      py::arg("model"), py::arg("qd"), py::arg("coulomb_band"),
+      "The viscous T^T (Fv w) and Coulomb T^T (Fs s(w)) friction terms: (2, n) or (T, 2, n).");
+  m.def(
+      "_link_frames",
+      [](PyModel& self, py::handle q) {
+        const int n = self.model->n();
+        return evaluate(
+            self, parse_samples({{q, "q"}}, n), frames_of_links(n),
+            [n](const Model& model, Workspace& ws, const double* const* in, double* frames) {
+              link_frames(model, ws, ConstVec(in[0], n), RowMajorMap(frames, n, 16));
+            });
+      },
+      py::arg("model"), py::arg("q"),
+      "World poses of the DH frames 1..n, base A_1 ... A_i: (n, 4, 4) or (T, n, 4, 4).");
+  m.def(
+      "_motor_friction",
+      [](py::handle K, py::handle B, py::handle Fv, py::handle Fs, py::handle thetad,
+         py::handle coulomb_band) {
+        const ElasticDrives d = drives_argument(K, B, Fv, Fs);
+        const double band = band_argument(coulomb_band);
+        return per_joint_law<1>(d, {{thetad, "thetad"}}, [&](int i, const auto& v) {
+          return detail::motor_friction(d, i, v[0], band);
+        });
+      },
+      py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
+      py::arg("motor_coulomb"), py::arg("thetad"), py::arg("coulomb_band"),
+      "Motor-side friction Fv_m thetad + Fs_m s(thetad) of elastic joints (paper eq. (2)).");
+  m.def(
+      "_motor_acceleration",
+      [](py::handle K, py::handle B, py::handle Fv, py::handle Fs, py::handle thetad,
+         py::handle tau, py::handle tau_J, py::handle coulomb_band) {
+        const ElasticDrives d = drives_argument(K, B, Fv, Fs);
+        const double band = band_argument(coulomb_band);
+        return per_joint_law<3>(d, {{thetad, "thetad"}, {tau, "tau"}, {tau_J, "tau_J"}},
+                                [&](int i, const auto& v) {
+                                  return detail::motor_acceleration(d, i, v[0], v[1], v[2], band);
+                                });
+      },
+      py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
+      py::arg("motor_coulomb"), py::arg("thetad"), py::arg("tau"), py::arg("tau_J"),
+      py::arg("coulomb_band"),
+      "thetadd = B^-1 (tau - tau_J - tau_F(thetad)): the motor equation (paper eq. (2)).");
+  m.def(
+      "_motor_torque",
+      [](py::handle K, py::handle B, py::handle Fv, py::handle Fs, py::handle thetad,
+         py::handle thetadd, py::handle tau_J, py::handle coulomb_band) {
+        const ElasticDrives d = drives_argument(K, B, Fv, Fs);
+        const double band = band_argument(coulomb_band);
+        return per_joint_law<3>(d, {{thetad, "thetad"}, {thetadd, "thetadd"}, {tau_J, "tau_J"}},
+                                [&](int i, const auto& v) {
+                                  return detail::motor_torque(d, i, v[0], v[1], v[2], band);
+                                });
+      },
+      py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
+      py::arg("motor_coulomb"), py::arg("thetad"), py::arg("thetadd"), py::arg("tau_J"),
+      py::arg("coulomb_band"),
+      "tau = B thetadd + tau_J + tau_F(thetad): the motor equation (paper eq. (2)).");
+}
+
+}  // namespace dynid::binding
