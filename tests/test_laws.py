@@ -212,3 +212,35 @@ def test_link_frames_bad_arguments_name_them() -> None:
         _core._link_frames(robot, np.zeros(4))
     with pytest.raises(ValueError, match=r"^q"):
         _core._link_frames(robot, np.full(6, np.inf))
+
+
+# ---- the asymmetric friction model ---------------------------------------------------------------
+@pytest.mark.parametrize("offset", [False, True])
+def test_asymmetric_friction_columns_give_the_law(offset: bool) -> None:
+    """Columns times coefficients is Fv+ max(qd, 0) + Fv- min(qd, 0) + Fs+ [qd > 0] - Fs- [qd < 0]
+    per joint (with offset: Fs sign(qd) for the Coulomb pair), written here, 1e-12."""
+    rng = np.random.default_rng(12)
+    qd = rng.uniform(-1.0, 1.0, (30, 4))
+    qd[::5, 0] = 0.0
+    Fv_pos, Fv_neg, Fs_pos, Fs_neg = rng.uniform(0.1, 2.0, (4, 4))
+    Y = _core._asymmetric_friction_columns(qd, offset)
+    viscous = Fv_pos * np.maximum(qd, 0) + Fv_neg * np.minimum(qd, 0)
+    if offset:
+        coefficients = np.concatenate([Fv_pos, Fv_neg, Fs_pos])
+        expected = viscous + Fs_pos * np.sign(qd)
+    else:
+        coefficients = np.concatenate([Fv_pos, Fv_neg, Fs_pos, Fs_neg])
+        expected = viscous + Fs_pos * (qd > 0) - Fs_neg * (qd < 0)
+    assert Y.shape == (30, 4, (3 if offset else 4) * 4)
+    np.testing.assert_allclose(Y @ coefficients, expected, rtol=0, atol=1e-12)
+    assert np.count_nonzero(Y[:, 0, :]) <= 3 * 30  # row j has entries in joint j's columns only
+    for j in range(4):
+        others = [c for c in range(Y.shape[2]) if c % 4 != j]
+        assert not Y[:, j, others].any()
+
+
+def test_asymmetric_friction_columns_bad_arguments_name_them() -> None:
+    with pytest.raises(ValueError, match=r"^qd: expected shape \(T, n\)"):
+        _core._asymmetric_friction_columns(np.zeros(3), False)
+    with pytest.raises(ValueError, match=r"^offset"):
+        _core._asymmetric_friction_columns(np.zeros((2, 3)), "yes")

@@ -117,6 +117,7 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     "thetad": ARRAY_LIKE,
     "thetadd": ARRAY_LIKE,
     "tau_J": ARRAY_LIKE,
+    ("_asymmetric_friction_columns", "offset"): "bool",
 }
 
 # Property setters (their single argument is unnamed in pybind11), by property name.

@@ -109,6 +109,30 @@ void bind_laws(py::module_& m) {
       py::arg("model"), py::arg("qd"), py::arg("coulomb_band"),
       "The viscous T^T (Fv w) and Coulomb T^T (Fs s(w)) friction terms: (2, n) or (T, 2, n).");
   m.def(
+      "_asymmetric_friction_columns",
+      [](py::handle qd_arg, py::handle offset_arg) {
+        const bool offset = parse_flag(offset_arg, "offset");
+        const Array qd = as_real_array(qd_arg, "qd");
+        if (qd.ndim() != 2 || qd.shape(1) < 1)
+          throw py::value_error("qd: expected shape (T, n) with n >= 1, got " + shape_string(qd));
+        require_finite(qd, "qd");
+        const py::ssize_t T = qd.shape(0);
+        const int n = static_cast<int>(qd.shape(1)), P = asymmetric_friction_columns(n, offset);
+        py::array_t<double> out({T, static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(P)});
+        double* Y = out.mutable_data();
+        const double* rows = qd.data();
+        {
+          py::gil_scoped_release release;
+          for (py::ssize_t t = 0; t < T; ++t)
+            asymmetric_friction_regressor(ConstVec(rows + t * n, n), offset,
+                                          RowMajorMap(Y + t * n * P, n, P));
+        }
+        return out;
+      },
+      py::arg("qd"), py::arg("offset"),
+      "Columns (T, n, 4n) of the asymmetric friction model for qd (T, n); (T, n, 3n) with "
+      "offset (Fv+, Fv-, Fs).");
+  m.def(
       "_link_frames",
       [](PyModel& self, py::handle q) {
         const int n = self.model->n();

@@ -47,4 +47,17 @@ void friction_terms(const Model& model, const VectorIn& qd, double coulomb_band,
   detail::add_drive_friction_terms(model, qd, coulomb_band, viscous, coulomb);
 }
 
+int asymmetric_friction_columns(int n, bool offset) { return (offset ? 3 : 4) * n; }
+
+void asymmetric_friction_regressor(const VectorIn& qd, bool offset, RowMajorOut Y) {
+  const int n = static_cast<int>(qd.size());
+  DYNID_CHECK_SHAPE(Y, n, asymmetric_friction_columns(n, offset));
+  Y.setZero();
+  double entries[4];
+  for (int j = 0; j < n; ++j) {
+    detail::asymmetric_friction_entries(qd[j], offset, entries);
+    for (int block = 0; block < (offset ? 3 : 4); ++block) Y(j, block * n + j) = entries[block];
+  }
+}
+
 }  // namespace dynid

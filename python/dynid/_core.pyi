@@ -503,6 +503,13 @@ class RecursiveLeastSquares:
         Current estimate (p,), a copy.
         """
 
+def _asymmetric_friction_columns(
+    qd: numpy.typing.ArrayLike, offset: bool
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Columns (T, n, 4n) of the asymmetric friction model for qd (T, n); (T, n, 3n) with offset (Fv+, Fv-, Fs).
+    """
+
 def _batch_isa() -> str:
     """
     The path batch calls of rnea, gravity and mass_matrix run on: 'scalar' (the per-sample kernels), 'sse2', 'avx2' or 'avx512' (SIMD lanes across samples).

@@ -21,4 +21,12 @@ void friction(const Model& model, const VectorIn& qd, double coulomb_band, Vecto
 void friction_terms(const Model& model, const VectorIn& qd, double coulomb_band, VectorOut viscous,
                     VectorOut coulomb);
 
+// The regressor of the asymmetric friction model (docs/identification.md, "Friction models"): Y
+// (n x asymmetric_friction_columns(n, offset)) with blocks of n columns max(qd_j, 0) (Fv+),
+// min(qd_j, 0) (Fv-), [qd_j > 0] (Fs+) and -[qd_j < 0] (Fs-), each in row j only; with `offset`
+// three blocks Fv+, Fv-, sign(qd_j) (Fs). Per joint on qd (no transmission: the model is refused
+// for coupled drives). std::invalid_argument naming Y for a wrong shape.
+int asymmetric_friction_columns(int n, bool offset);
+void asymmetric_friction_regressor(const VectorIn& qd, bool offset, RowMajorOut Y);
+
 }  // namespace dynid

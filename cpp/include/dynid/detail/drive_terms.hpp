@@ -33,6 +33,21 @@ inline double coulomb_shape(double w, double band) {
 // of an elastic joint): Fv w + Fs s, with s = sign(w) or coulomb_shape(w, band).
 inline double friction_law(double Fv, double Fs, double w, double s) { return Fv * w + Fs * s; }
 
+// The asymmetric law of one joint (python/dynid/friction_models.py; FloBaRoID's asymmetric viscous
+// friction): Fv+ max(w, 0) + Fv- min(w, 0) + Fs+ [w > 0] - Fs- [w < 0], as its regressor entries
+// {max(w, 0), min(w, 0), [w > 0], -[w < 0]}; with `offset` the Coulomb pair is one symmetric
+// entry sign(w) (the offset carries the asymmetry). Writes 4 entries, or 3 with `offset`.
+inline void asymmetric_friction_entries(double w, bool offset, double* entries) {
+  entries[0] = w > 0.0 ? w : 0.0;
+  entries[1] = w < 0.0 ? w : 0.0;
+  if (offset) {
+    entries[2] = sign(w);
+  } else {
+    entries[2] = w > 0.0 ? 1.0 : 0.0;
+    entries[3] = w < 0.0 ? -1.0 : 0.0;
+  }
+}
+
 // Decoupled joint i: Fv_i qd + Fs_i sign(qd).
 inline double friction_torque(const Model& model, int i, double qd) {
   return friction_law(model.viscous_friction()[i], model.coulomb_friction()[i], qd, sign(qd));
