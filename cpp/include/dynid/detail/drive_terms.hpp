@@ -53,6 +53,22 @@ inline double friction_torque(const Model& model, int i, double qd) {
   return friction_law(model.viscous_friction()[i], model.coulomb_friction()[i], qd, sign(qd));
 }
 
+// Decoupled joint i: Ia_i qdd + Fv_i qd + Fs_i sign(qd), all its drive terms.
+inline double drive_torque(const Model& model, int i, double qd, double qdd) {
+  return model.rotor_inertia()[i] * qdd + friction_torque(model, i, qd);
+}
+
+// Decoupled joint i: Ia_i acc + Fv_i vel, the drive terms without Coulomb (their time
+// derivatives: Coulomb is flat away from zero velocity).
+inline double drive_linear_torque(const Model& model, int i, double vel, double acc) {
+  return model.rotor_inertia()[i] * acc + model.viscous_friction()[i] * vel;
+}
+
+// Decoupled joint i: 1/2 Ia_i qd^2, its rotor's kinetic energy.
+inline double rotor_energy(const Model& model, int i, double qd) {
+  return 0.5 * model.rotor_inertia()[i] * qd * qd;
+}
+
 // Motor k's share of a joint-space vector: (T v)_k (theta_dot_k for v = qd).
 template <class V>
 inline double motor_value(const Model& model, int k, const V& v) {
@@ -116,7 +132,7 @@ template <class Qd, class Qdd, class Tau>
 inline void add_drive_torque(const Model& model, const Qd& qd, const Qdd& qdd, Tau& tau) {
   const VectorX& Ia = model.rotor_inertia();
   if (model.transmission_is_identity()) {
-    for (int i = 0; i < model.n(); ++i) tau[i] += Ia[i] * qdd[i] + friction_torque(model, i, qd[i]);
+    for (int i = 0; i < model.n(); ++i) tau[i] += drive_torque(model, i, qd[i], qdd[i]);
     return;
   }
   const VectorX& Fv = model.viscous_friction();
@@ -134,7 +150,7 @@ inline void add_drive_linear(const Model& model, const Vel& vel, const Acc& acc,
   const VectorX& Ia = model.rotor_inertia();
   const VectorX& Fv = model.viscous_friction();
   if (model.transmission_is_identity()) {
-    for (int i = 0; i < model.n(); ++i) out[i] += Ia[i] * acc[i] + Fv[i] * vel[i];
+    for (int i = 0; i < model.n(); ++i) out[i] += drive_linear_torque(model, i, vel[i], acc[i]);
     return;
   }
   for (int k = 0; k < model.n(); ++k)
@@ -163,11 +179,10 @@ inline void add_drive_damping(const Model& model, Matrix& D) {
 // 1/2 (T qd)^T diag(Ia) (T qd): the rotors' kinetic energy.
 template <class Qd>
 inline double rotor_kinetic_energy(const Model& model, const Qd& qd) {
-  const VectorX& Ia = model.rotor_inertia();
   double E = 0.0;
   for (int k = 0; k < model.n(); ++k) {
     const double w = model.transmission_is_identity() ? qd[k] : motor_value(model, k, qd);
-    E += 0.5 * Ia[k] * w * w;
+    E += rotor_energy(model, k, w);
   }
   return E;
 }
