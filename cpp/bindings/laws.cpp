@@ -7,10 +7,10 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "arrays.hpp"
-#include "dynid/detail/elastic_motor.hpp"
 #include "dynid/elastic_motor.hpp"
 #include "dynid/friction.hpp"
 #include "dynid/kinematics.hpp"
@@ -48,12 +48,24 @@ ElasticDrives drives_argument(py::handle K, py::handle B, py::handle Fv, py::han
   return drives;
 }
 
-// kernel(joint i, the inputs' values at (t, i)) -> the output at (t, i), for inputs of one sample
-// (n,) or T samples (T, n), looped in C++ without the GIL; the output has the inputs' shape.
+template <std::size_t N, std::size_t... I>
+std::array<ConstVec, N> inputs_of(const Samples& s, py::ssize_t t, int n,
+                                  std::index_sequence<I...>) {
+  return {ConstVec(s.row(I, t, n), n)...};
+}
+
+template <std::size_t N>
+std::array<ConstVec, N> make_inputs(const Samples& s, py::ssize_t t, int n) {
+  return inputs_of<N>(s, t, n, std::make_index_sequence<N>());
+}
+
+// kernel(inputs of sample t as (n,) vectors..., output row) calls the core on one sample; inputs
+// of one sample (n,) or T samples (T, n), looped in C++ without the GIL; the output has their
+// shape.
 template <std::size_t N, class Kernel>
-py::array per_joint_law(const ElasticDrives& drives,
-                        std::initializer_list<std::pair<py::handle, const char*>> inputs,
-                        Kernel kernel) {
+py::array per_sample_law(const ElasticDrives& drives,
+                         std::initializer_list<std::pair<py::handle, const char*>> inputs,
+                         Kernel kernel) {
   const int n = static_cast<int>(drives.stiffness.size());
   const Samples s = parse_samples(inputs, n);
   std::vector<py::ssize_t> shape{n};
@@ -62,12 +74,10 @@ py::array per_joint_law(const ElasticDrives& drives,
   double* result = out.mutable_data();
   {
     py::gil_scoped_release release;
-    std::array<double, N> values{};
-    for (py::ssize_t t = 0; t < s.count; ++t)
-      for (int i = 0; i < n; ++i) {
-        for (std::size_t k = 0; k < N; ++k) values[k] = s.row(k, t, n)[i];
-        result[t * n + i] = kernel(i, values);
-      }
+    for (py::ssize_t t = 0; t < s.count; ++t) {
+      std::array<ConstVec, N> in = make_inputs<N>(s, t, n);
+      kernel(in, OutVec(result + t * n, n));
+    }
   }
   require_finite_result(result, static_cast<py::ssize_t>(out.size()), s.names.c_str());
   return out;
@@ -150,8 +160,8 @@ void bind_laws(py::module_& m) {
          py::handle coulomb_band) {
         const ElasticDrives d = drives_argument(K, B, Fv, Fs);
         const double band = band_argument(coulomb_band);
-        return per_joint_law<1>(d, {{thetad, "thetad"}}, [&](int i, const auto& v) {
-          return detail::motor_friction(d, i, v[0], band);
+        return per_sample_law<1>(d, {{thetad, "thetad"}}, [&](const auto& in, OutVec tau_F) {
+          motor_friction(d, in[0], band, tau_F);
         });
       },
       py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
@@ -163,10 +173,10 @@ void bind_laws(py::module_& m) {
          py::handle tau, py::handle tau_J, py::handle coulomb_band) {
         const ElasticDrives d = drives_argument(K, B, Fv, Fs);
         const double band = band_argument(coulomb_band);
-        return per_joint_law<3>(d, {{thetad, "thetad"}, {tau, "tau"}, {tau_J, "tau_J"}},
-                                [&](int i, const auto& v) {
-                                  return detail::motor_acceleration(d, i, v[0], v[1], v[2], band);
-                                });
+        return per_sample_law<3>(d, {{thetad, "thetad"}, {tau, "tau"}, {tau_J, "tau_J"}},
+                                 [&](const auto& in, OutVec thetadd) {
+                                   motor_acceleration(d, in[0], in[1], in[2], band, thetadd);
+                                 });
       },
       py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
       py::arg("motor_coulomb"), py::arg("thetad"), py::arg("tau"), py::arg("tau_J"),
@@ -178,10 +188,9 @@ void bind_laws(py::module_& m) {
          py::handle thetadd, py::handle tau_J, py::handle coulomb_band) {
         const ElasticDrives d = drives_argument(K, B, Fv, Fs);
         const double band = band_argument(coulomb_band);
-        return per_joint_law<3>(d, {{thetad, "thetad"}, {thetadd, "thetadd"}, {tau_J, "tau_J"}},
-                                [&](int i, const auto& v) {
-                                  return detail::motor_torque(d, i, v[0], v[1], v[2], band);
-                                });
+        return per_sample_law<3>(
+            d, {{thetad, "thetad"}, {thetadd, "thetadd"}, {tau_J, "tau_J"}},
+            [&](const auto& in, OutVec tau) { motor_torque(d, in[0], in[1], in[2], band, tau); });
       },
       py::arg("stiffness"), py::arg("motor_inertia"), py::arg("motor_viscous"),
       py::arg("motor_coulomb"), py::arg("thetad"), py::arg("thetadd"), py::arg("tau_J"),
