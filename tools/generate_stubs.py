@@ -112,6 +112,12 @@ ARGUMENT_TYPES: dict[str | tuple[str, ...], str] = {
     ("_simulate_elastic_kuka", "q_d"): ARRAY_LIKE,
     ("_simulate_elastic_kuka", "qd_d"): ARRAY_LIKE,
     ("_simulate_elastic_kuka", "tau_user"): f"{ARRAY_LIKE} | None",
+    # the laws' core functions (cpp/bindings/laws.cpp)
+    "coulomb_band": "float",
+    "thetad": ARRAY_LIKE,
+    "thetadd": ARRAY_LIKE,
+    "tau_J": ARRAY_LIKE,
+    ("_asymmetric_friction_columns", "offset"): "bool",
 }
 
 # Property setters (their single argument is unnamed in pybind11), by property name.

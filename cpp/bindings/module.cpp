@@ -6,6 +6,7 @@
 #include "elastic.hpp"
 #include "fast_calls.hpp"
 #include "lanes.hpp"
+#include "laws.hpp"
 #include "model.hpp"
 #include "recursive_least_squares.hpp"
 #include "signal.hpp"
@@ -25,6 +26,7 @@ PYBIND11_MODULE(_core, m) {
   dynid::binding::bind_recursive_least_squares(m);
   dynid::binding::bind_simulator(m);
   dynid::binding::bind_signal(m);
+  dynid::binding::bind_laws(m);  // friction, elastic motor equation, link frames (laws.hpp)
   m.def(
       "standard_parameters",
       [](double mass, py::handle com, py::handle inertia_com) {

@@ -8,6 +8,7 @@
 
 #include "dynid/detail/argument_checks.hpp"
 #include "dynid/detail/composite_rigid_body.hpp"
+#include "dynid/detail/elastic_motor.hpp"
 #include "dynid/detail/kinematics.hpp"
 #include "dynid/detail/newton_euler.hpp"
 #include "dynid/gravity.hpp"
@@ -18,17 +19,6 @@ namespace {
 template <class Message>
 void require(bool ok, Message message) {
   if (!ok) throw std::invalid_argument(message());
-}
-
-void check_drive(const VectorX& v, int n, bool positive, const char* name) {
-  require(v.size() == n, [&] {
-    return std::string(name) + ": expected " + std::to_string(n) + " values, got " +
-           std::to_string(v.size());
-  });
-  require(v.allFinite() && (positive ? (v.array() > 0.0).all() : (v.array() >= 0.0).all()), [&] {
-    return std::string(name) +
-           (positive ? ": expected finite values > 0" : ": expected finite values >= 0");
-  });
 }
 
 void check_size(const VectorIn& v, int n, const char* name) {
@@ -75,10 +65,7 @@ ElasticSimulator::ElasticSimulator(const Model& links, const ElasticDrives& driv
       substeps_(substeps),
       workspace_(links) {
   const int n = links.n();
-  check_drive(drives.stiffness, n, true, "stiffness");
-  check_drive(drives.motor_inertia, n, true, "motor_inertia");
-  check_drive(drives.motor_viscous, n, false, "motor_viscous");
-  check_drive(drives.motor_coulomb, n, false, "motor_coulomb");
+  check_elastic_drives(drives, n);
   require(std::isfinite(dt) && dt > 0.0,
           [&] { return "dt: expected a positive control period, got " + std::to_string(dt); });
   require(substeps >= 1,
@@ -113,14 +100,9 @@ void ElasticSimulator::rate(const VectorIn& x, const VectorIn& tau, VectorOut xd
   auto thetadd = xd.segment(3 * n, n);
   for (int i = 0; i < n; ++i) {
     const double tau_J = drives_.stiffness[i] * (theta[i] - q[i]);
-    const double w = thetad[i];
-    const double coulomb = coulomb_band_ > 0.0 ? std::tanh(w / coulomb_band_)
-                                               : static_cast<double>((w > 0.0) - (w < 0.0));
     qdd[i] = tau_J - ws.bias[i];
-    // Motor equation (paper eq. (2)): B thetadd = tau - tau_J - tau_F.
-    thetadd[i] =
-        (tau[i] - tau_J - drives_.motor_viscous[i] * w - drives_.motor_coulomb[i] * coulomb) /
-        drives_.motor_inertia[i];
+    // Motor equation (paper eq. (2)): B thetadd = tau - tau_J - tau_F (detail/elastic_motor.hpp).
+    thetadd[i] = detail::motor_acceleration(drives_, i, thetad[i], tau[i], tau_J, coulomb_band_);
   }
   ws.cholesky.solveInPlace(qdd);
 }

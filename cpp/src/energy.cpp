@@ -32,7 +32,7 @@ double kinetic_energy(const Model& model, Workspace& workspace, const VectorIn& 
     const Vector3& wi = ws.omega[i];
     const Vector3& vi = ws.v[i];
     T += 0.5 * (b.m * vi.squaredNorm() + wi.dot(b.I * wi)) + vi.dot(wi.cross(b.h));
-    if (decoupled) T += 0.5 * model.rotor_inertia()[i - 1] * qd[i - 1] * qd[i - 1];
+    if (decoupled) T += detail::rotor_energy(model, i - 1, qd[i - 1]);
   }
   if (!decoupled) T += detail::rotor_kinetic_energy(model, qd);
   return T;

@@ -66,6 +66,22 @@ void fkine(const Model& model, Workspace& workspace, const VectorIn& q, MatrixOu
   T = detail::tool_pose(model, ws);
 }
 
+void link_frames(const Model& model, Workspace& workspace, const VectorIn& q, RowMajorOut frames) {
+  detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
+  DYNID_CHECK_JOINT_VECTOR(q, model);
+  DYNID_CHECK_SHAPE(frames, model.n(), 16);
+  detail::update_joint_transforms(model, ws, q);
+  detail::update_world_frames(model, ws);
+  for (int i = 1; i <= ws.n; ++i) {
+    // DH frame i = J_i * link_offset(i) (model.hpp): Tx(a_i) Rx(alpha_i) for standard DH.
+    const detail::LinkOffset& offset = model.link_offset(i - 1);
+    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> pose(frames.row(i - 1).data());
+    pose.topLeftCorner<3, 3>() = ws.R_world[i] * offset.rotation();
+    pose.topRightCorner<3, 1>() = ws.p_world[i] + ws.R_world[i] * offset.translation();
+    pose.row(3) << 0.0, 0.0, 0.0, 1.0;
+  }
+}
+
 void jacobian(const Model& model, Workspace& workspace, const VectorIn& q, MatrixOut J) {
   detail::WorkspaceBuffers& ws = DYNID_CHECKED_BUFFERS(model, workspace);
   DYNID_CHECK_JOINT_VECTOR(q, model);

@@ -106,8 +106,6 @@ void rnea_time_derivatives(const Model& model, Workspace& workspace, const Vecto
   // Decoupled drive terms joint by joint (as before the transmission existed), coupled ones
   // through T after the pass (detail/drive_terms.hpp).
   const bool decoupled = model.transmission_is_identity();
-  const VectorX& Ia = model.rotor_inertia();
-  const VectorX& Fv = model.viscous_friction();
   for (int i = n; i >= 1; --i) {
     if (i < n) {
       d.force[i] += d.force[i + 1];
@@ -118,9 +116,10 @@ void rnea_time_derivatives(const Model& model, Workspace& workspace, const Vecto
     const Vector6 &F = d.force[i], &F1 = d.force_dot[i], &F2 = d.force_ddot[i];
     const int k = i - 1;
     if (decoupled) {
-      tau[k] = S.dot(F) + Ia[k] * qdd[k] + detail::friction_torque(model, k, qd[k]);
-      tau_dot[k] = S1.dot(F) + S.dot(F1) + Ia[k] * qddd[k] + Fv[k] * qdd[k];
-      tau_ddot[k] = S2.dot(F) + 2.0 * S1.dot(F1) + S.dot(F2) + Ia[k] * qdddd[k] + Fv[k] * qddd[k];
+      tau[k] = S.dot(F) + detail::drive_torque(model, k, qd[k], qdd[k]);
+      tau_dot[k] = S1.dot(F) + S.dot(F1) + detail::drive_linear_torque(model, k, qdd[k], qddd[k]);
+      tau_ddot[k] = S2.dot(F) + 2.0 * S1.dot(F1) + S.dot(F2) +
+                    detail::drive_linear_torque(model, k, qddd[k], qdddd[k]);
     } else {
       tau[k] = S.dot(F);
       tau_dot[k] = S1.dot(F) + S.dot(F1);

@@ -77,9 +77,8 @@ void Simulator::acceleration(const VectorIn& q, const VectorIn& qd, const Vector
   detail::newton_euler(plant_, ws, qd, ws.zeros, -plant_.gravity_base(), ws.bias);
   if (settings_.friction) {
     const double band = settings_.coulomb_band;
-    detail::add_drive_friction(plant_, qd, ws.bias, [band](double w) {
-      return band > 0.0 ? std::tanh(w / band) : detail::sign(w);
-    });
+    detail::add_drive_friction(plant_, qd, ws.bias,
+                               [band](double w) { return detail::coulomb_shape(w, band); });
   }
   detail::composite_rigid_body(plant_, ws, ws.M);
   detail::add_drive_inertia(plant_, ws.M);

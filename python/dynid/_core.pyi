@@ -517,14 +517,80 @@ class RecursiveLeastSquares:
         Current estimate (p,), a copy.
         """
 
+def _asymmetric_friction_columns(
+    qd: numpy.typing.ArrayLike, offset: bool
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Columns (T, n, 4n) of the asymmetric friction model for qd (T, n); (T, n, 3n) with offset (Fv+, Fv-, Fs).
+    """
+
 def _batch_isa() -> str:
     """
     The path batch calls of rnea, gravity and mass_matrix run on: 'scalar' (the per-sample kernels), 'sse2', 'avx2' or 'avx512' (SIMD lanes across samples).
     """
 
+def _friction(
+    model: Model, qd: numpy.typing.ArrayLike, coulomb_band: float
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Drive friction T^T (Fv w + Fs s(w)), w = T qd, s = tanh(. / coulomb_band) (sign for 0): (n,) or (T, n) like qd.
+    """
+
+def _friction_terms(
+    model: Model, qd: numpy.typing.ArrayLike, coulomb_band: float
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The viscous T^T (Fv w) and Coulomb T^T (Fs s(w)) friction terms: (2, n) or (T, 2, n).
+    """
+
 def _last_batch_threads() -> int:
     """
     Threads the last batch call ran on.
+    """
+
+def _link_frames(model: Model, q: numpy.typing.ArrayLike) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    World poses of the DH frames 1..n, base A_1 ... A_i: (n, 4, 4) or (T, n, 4, 4).
+    """
+
+def _motor_acceleration(
+    stiffness: numpy.typing.ArrayLike,
+    motor_inertia: numpy.typing.ArrayLike,
+    motor_viscous: numpy.typing.ArrayLike,
+    motor_coulomb: numpy.typing.ArrayLike,
+    thetad: numpy.typing.ArrayLike,
+    tau: numpy.typing.ArrayLike,
+    tau_J: numpy.typing.ArrayLike,
+    coulomb_band: float,
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    thetadd = B^-1 (tau - tau_J - tau_F(thetad)): the motor equation (paper eq. (2)).
+    """
+
+def _motor_friction(
+    stiffness: numpy.typing.ArrayLike,
+    motor_inertia: numpy.typing.ArrayLike,
+    motor_viscous: numpy.typing.ArrayLike,
+    motor_coulomb: numpy.typing.ArrayLike,
+    thetad: numpy.typing.ArrayLike,
+    coulomb_band: float,
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    Motor-side friction Fv_m thetad + Fs_m s(thetad) of elastic joints (paper eq. (2)).
+    """
+
+def _motor_torque(
+    stiffness: numpy.typing.ArrayLike,
+    motor_inertia: numpy.typing.ArrayLike,
+    motor_viscous: numpy.typing.ArrayLike,
+    motor_coulomb: numpy.typing.ArrayLike,
+    thetad: numpy.typing.ArrayLike,
+    thetadd: numpy.typing.ArrayLike,
+    tau_J: numpy.typing.ArrayLike,
+    coulomb_band: float,
+) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    tau = B thetadd + tau_J + tau_F(thetad): the motor equation (paper eq. (2)).
     """
 
 def _result_pool() -> tuple[int, int]:

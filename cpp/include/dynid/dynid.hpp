@@ -6,6 +6,7 @@
 #include "dynid/coriolis.hpp"
 #include "dynid/coriolis_matrix.hpp"
 #include "dynid/crba.hpp"
+#include "dynid/elastic_motor.hpp"
 #include "dynid/elastic_simulator.hpp"
 #include "dynid/energy.hpp"
 #include "dynid/forward_dynamics.hpp"

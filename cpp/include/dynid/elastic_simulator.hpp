@@ -9,16 +9,11 @@
 // controller.
 #pragma once
 
+#include "dynid/elastic_motor.hpp"  // ElasticDrives and the motor equation
 #include "dynid/model.hpp"
 #include "dynid/workspace.hpp"
 
 namespace dynid {
-
-// Motor side of the drives, one entry per joint: stiffness K > 0, motor inertia B > 0, motor
-// viscous Fv_m >= 0 and Coulomb Fs_m >= 0 friction.
-struct ElasticDrives {
-  VectorX stiffness, motor_inertia, motor_viscous, motor_coulomb;
-};
 
 // Called once per control period k (t = k dt) with the exact link and motor state and the elastic
 // torque tau_J = K (theta - q) (what the joint torque sensors measure).

@@ -34,6 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _core
+
 #: The friction models of :func:`dynid.identify_log` (``friction=``).
 FRICTION_MODELS = ("none", "symmetric", "asymmetric")
 
@@ -64,20 +66,12 @@ def asymmetric_columns(qd: NDArray[np.float64], offset: bool) -> NDArray[np.floa
     """(T, n, 4 n) columns of the asymmetric friction model for joint velocities ``qd`` (T, n):
     blocks of n columns max(qd_j, 0) (Fv+), min(qd_j, 0) (Fv-), [qd_j > 0] (Fs+) and
     -[qd_j < 0] (Fs-), each in row j only; with ``offset`` (T, n, 3 n): Fv+, Fv-, then
-    sign(qd_j) (Fs). Vectorised over the samples."""
+    sign(qd_j) (Fs). The law's one home is the C++ core (``dynid::asymmetric_friction_regressor``,
+    cpp/src/friction.cpp), looped over the samples there."""
     qd = np.asarray(qd, dtype=float)
     if qd.ndim == 1:
         qd = qd[None]
-    T, n = qd.shape
-    blocks = [np.maximum(qd, 0.0), np.minimum(qd, 0.0)]
-    if offset:
-        blocks.append(np.sign(qd))
-    else:
-        blocks += [(qd > 0).astype(float), -(qd < 0).astype(float)]
-    columns = np.zeros((T, n, len(blocks) * n))
-    rows = np.arange(n)
-    for k, block in enumerate(blocks):
-        columns[:, rows, k * n + rows] = block
+    columns: NDArray[np.float64] = _core._asymmetric_friction_columns(qd, bool(offset))
     return columns
 
 

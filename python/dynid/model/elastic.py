@@ -20,7 +20,9 @@ recursion (``Robot.rnea_time_derivatives``), then
     tau = B thetadd + tau_l + tau_F(thetad)
 
 (the paper's eq. (4) solved for tau). Every call takes one sample (n,) or T samples (T, n); the
-per-sample dynamics run in C++ batch calls, the rest is elementwise NumPy.
+per-sample dynamics run in C++ batch calls, the motor equation and its friction too (its one home,
+cpp/include/dynid/elastic_motor.hpp, shared with the elastic simulator); the rest is elementwise
+NumPy.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
+from .. import _core
 from .robot import Robot
 
 if TYPE_CHECKING:
@@ -88,7 +91,8 @@ class ElasticRobot:
     def motor_friction(self, thetad: ArrayLike) -> Array:
         """tau_F = Fv_m thetad + Fs_m sign(thetad), sign(0) = 0 (motor side, paper eq. (2))."""
         (thetad_,) = self._samples(thetad=thetad)
-        return self.Fv_m * thetad_ + self.Fs_m * np.sign(thetad_)
+        friction: Array = _core._motor_friction(*self._drives, thetad_, 0.0)
+        return friction
 
     def energy(
         self, q: ArrayLike, qd: ArrayLike, theta: ArrayLike, thetad: ArrayLike
@@ -114,7 +118,7 @@ class ElasticRobot:
         )
         tau_J = self.K * (theta_ - q_)
         qdd = self.link.forward_dynamics(q_, qd_, tau_J)
-        thetadd = (tau_ - tau_J - self.Fv_m * thetad_ - self.Fs_m * np.sign(thetad_)) / self.B
+        thetadd: Array = _core._motor_acceleration(*self._drives, thetad_, tau_, tau_J, 0.0)
         return qdd, thetadd
 
     def motor_motion(
@@ -134,7 +138,7 @@ class ElasticRobot:
         tau = B thetadd + K (theta - q) + tau_F(thetad). One sample (n,) each or (T, n)."""
         theta, thetad, thetadd, tau_l = self._flat_output(q, qd, qdd, qddd, qdddd)
         # K (theta - q) is tau_l itself: using it avoids the cancellation in theta - q for stiff K
-        tau = self.B * thetadd + tau_l + self.Fv_m * thetad + self.Fs_m * np.sign(thetad)
+        tau: Array = _core._motor_torque(*self._drives, thetad, thetadd, tau_l, 0.0)
         return theta, tau
 
     def _flat_output(
@@ -146,6 +150,11 @@ class ElasticRobot:
         return (q_ + tau_l / self.K, qd_ + tau_l_dot / self.K, qdd_ + tau_l_ddot / self.K, tau_l)
 
     # ---- helpers -------------------------------------------------------------------------------
+    @property
+    def _drives(self) -> tuple[Array, Array, Array, Array]:
+        """(K, B, Fv_m, Fs_m): the drives as the C++ motor equation takes them."""
+        return self.K, self.B, self.Fv_m, self.Fs_m
+
     def _samples(self, **arrays: ArrayLike) -> list[Array]:
         """Each argument as float64 (n,) or (T, n), all of the first one's shape; ValueError
         naming the argument otherwise."""

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _core
 from . import robot_fields
 from .pseudo_inertia import pseudo_inertia, standard_from_pseudo_inertia
 from .robot import Robot
@@ -30,18 +31,9 @@ TOLERANCE = 1e-9
 
 def link_frames(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """World poses (T, n, 4, 4) of the DH frames 1..n at the configurations q (T, n): base ·
-    A_1 ... A_i (the tool transform excluded)."""
-    q = np.atleast_2d(q)
-    frames = np.empty((q.shape[0], robot.n, 4, 4))
-    for i in range(1, robot.n + 1):
-        chain = Robot.from_dh(
-            robot.dh[:i],
-            robot.joint_types[:i],
-            robot.convention,
-            robot.gravity_vector,
-            base=robot.base,
-        )
-        frames[:, i - 1] = chain.fkine(q[:, :i])
+    A_1 ... A_i (the tool transform excluded), from one C++ forward pass per sample
+    (``dynid::link_frames``, cpp/src/kinematics.cpp)."""
+    frames: NDArray[np.float64] = _core._link_frames(robot, np.atleast_2d(q))
     return frames
 
 

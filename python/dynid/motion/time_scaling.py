@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
+from .. import _core
 from .._checks import real_array
 from ..model.robot import Robot
 
@@ -149,15 +150,11 @@ def _parts(
     qd = real_array(qd, "qd")
     if qd.shape != tau.shape:
         raise ValueError(f"qd: expected the shape of tau {tau.shape}, got {qd.shape}")
-    # Coupled drives (docs/transmission.md): the same terms on the motor velocities T qd, mapped
-    # back by T^T; they scale the same way.
-    T = robot.transmission
-    coupled = robot.coupled
-    w = qd @ T.T if coupled else qd
-    viscous = robot.Fv * w
-    coulomb = robot.Fs * np.sign(w)  # sign(w / k) = sign(w) for k > 0, sign(0) = 0
-    if coupled:
-        viscous, coulomb = viscous @ T, coulomb @ T
+    # The friction law's two terms from the C++ core (dynid::friction_terms, exact sign: band 0):
+    # T^T (Fv . T qd) and T^T (Fs . sign(T qd)) with coupled drives (docs/transmission.md); they
+    # scale the same way. sign(w / k) = sign(w) for k > 0, sign(0) = 0.
+    terms = _core._friction_terms(robot, qd, 0.0)
+    viscous, coulomb = terms[..., 0, :], terms[..., 1, :]
     inertial = tau - gravity - viscous - coulomb  # (B + diag(Ia)) qdd + c: scales as 1/k^2
     return gravity + coulomb, viscous, inertial
 

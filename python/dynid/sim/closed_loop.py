@@ -150,17 +150,14 @@ def plant_friction(robot: Robot, qd: ArrayLike, coulomb_band: float = 1e-3) -> N
     """The friction torque the simulator's plant applies, Fv qd + Fs tanh(qd / coulomb_band)
     (sign(qd) for a zero band), for one sample (n,) or T samples (T, n). With coupled drives
     (``robot.transmission`` T) the friction acts on the motor velocities T qd and reaches the
-    joints as T^T (Fv T qd + Fs tanh(T qd / band)) (docs/transmission.md)."""
+    joints as T^T (Fv T qd + Fs tanh(T qd / band)) (docs/transmission.md). The law is the
+    simulator's own, evaluated in C++ (``dynid::friction`` with a band, cpp/src/friction.cpp)."""
     qd = real_array(qd, "qd")
     if qd.shape[-1:] != (robot.n,) or qd.ndim > 2:
         raise ValueError(f"qd: expected shape ({robot.n},) or (T, {robot.n}), got {qd.shape}")
     band = _number(coulomb_band, "coulomb_band", positive=False)
-    T = robot.transmission
-    coupled = not np.array_equal(T, np.eye(robot.n))
-    w = qd @ T.T if coupled else qd  # motor velocities
-    coulomb = np.tanh(w / band) if band > 0.0 else np.sign(w)
-    motor = robot.Fv * w + robot.Fs * coulomb
-    return motor @ T if coupled else motor
+    friction: NDArray[np.float64] = _core._friction(robot, qd, band)
+    return friction
 
 
 def _controller_arguments(
