@@ -42,7 +42,9 @@ struct RotorOption {
 inline constexpr auto kCalls = std::make_tuple(
     call<ReturnsArrayOrOut>(
         "rnea", {"q", "qd", "qdd"}, per_joint,
-        [](const auto& s, double* tau) { rnea(s.model, s.ws, s[0], s[1], s[2], OutVec(tau, s.n())); },
+        [](const auto& s, double* tau) {
+          rnea(s.model, s.ws, s[0], s[1], s[2], OutVec(tau, s.n()));
+        },
         [](const auto& b, batch::Results tau) {
           return batch::rnea(b.model, b.ws, b[0], b[1], b[2], tau);
         },
@@ -79,9 +81,7 @@ inline constexpr auto kCalls = std::make_tuple(
     call<ReturnsArrayOrOut>(
         "friction", {"qd"}, per_joint,
         [](const auto& s, double* tau) { friction(s.model, s[0], OutVec(tau, s.n())); },
-        [](const auto& b, batch::Results tau) {
-          return batch::friction(b.model, b.ws, b[0], tau);
-        },
+        [](const auto& b, batch::Results tau) { return batch::friction(b.model, b.ws, b[0], tau); },
         "Joint friction Fv qd + Fs sign(qd); T^T (Fv T qd + Fs sign(T qd)) with a transmission "
         "T."),
     call<ReturnsArrayOrOut>(
@@ -152,8 +152,8 @@ inline constexpr auto kCalls = std::make_tuple(
           const RegressorOptions& o = b.options;
           if (o.columns.empty())
             return batch::regressor(b.model, b.ws, b[0], b[1], b[2], o.rotor, o.friction, Y);
-          return batch::regressor(b.model, b.ws, b[0], b[1], b[2], o.rotor, o.friction,
-                                  o.columns, Y);
+          return batch::regressor(b.model, b.ws, b[0], b[1], b[2], o.rotor, o.friction, o.columns,
+                                  Y);
         },
         "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; "
         "with "

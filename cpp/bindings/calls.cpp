@@ -34,8 +34,9 @@ struct IsParts<ReturnsParts<P>> : std::true_type {};
 
 // What the pybind11 method returns (its signature shows it): an array, a float or an array
 // (object), or a tuple of arrays.
-template <class Returns, class = std::make_index_sequence<IsParts<Returns>::value ? 3 : 0>>
-struct PythonResult {
+template <class Returns, class = std::make_index_sequence < IsParts<Returns>::value
+                                     ? 3
+                                     : 0 >> struct PythonResult {
   using type = std::conditional_t<kFloat<Returns>, py::object, py::array>;
 };
 template <int P, std::size_t... I>
@@ -131,8 +132,7 @@ py::arg_v option_arg(const OptionArg& option) {
 
 // The pybind11 method of entry K: (self, inputs..., options..., [out]).
 template <std::size_t K, std::size_t... I, std::size_t... J>
-void define_method(py::class_<PyModel>& cls, std::index_sequence<I...>,
-                   std::index_sequence<J...>) {
+void define_method(py::class_<PyModel>& cls, std::index_sequence<I...>, std::index_sequence<J...>) {
   const auto& c = std::get<K>(kCalls);
   using Options = typename Entry<K>::options;
   using Returns = typename Entry<K>::returns;
@@ -172,7 +172,8 @@ PyObject* fast_call(PyObject* self, PyObject* const* args, Py_ssize_t nargsf, Py
   const int n = m->model->n();
   const double* in[kInputs<K>];
   for (std::size_t k = 0; k < kInputs<K>; ++k)
-    if (!(in[k] = plain_vector(args[k], n))) return fallback(g_full<K>, self, args, nargsf, kwnames);
+    if (!(in[k] = plain_vector(args[k], n)))
+      return fallback(g_full<K>, self, args, nargsf, kwnames);
   const Options options{};
   const Shape shape = c.shape(n, options);
   double scalar = 0.0;

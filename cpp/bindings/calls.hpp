@@ -99,8 +99,8 @@ constexpr auto call(const char* name, const char* const (&inputs)[N], ShapeOf sh
                     BatchOf batch, const char* doc, bool params_error = false) {
   std::array<const char*, N> names{};
   for (std::size_t k = 0; k < N; ++k) names[k] = inputs[k];
-  return Call<Returns, Options, N, ShapeOf, Single, BatchOf>{name,   names, shape, single,
-                                                             batch,  doc,   params_error};
+  return Call<Returns, Options, N, ShapeOf, Single, BatchOf>{name,  names, shape,       single,
+                                                             batch, doc,   params_error};
 }
 
 // Shapes of one sample's result.
@@ -123,10 +123,10 @@ constexpr bool complete_entry(const C& c) {
   else
     static_assert(std::is_invocable_v<decltype(c.single), const Sample<Options>&, double*>,
                   "single(sample, result)");
-  static_assert(std::is_same_v<std::invoke_result_t<decltype(c.batch), const Batch<Options>&,
-                                                    batch::Results>,
-                               batch::Report>,
-                "batch(batch, results) -> dynid::batch::Report");
+  static_assert(
+      std::is_same_v<std::invoke_result_t<decltype(c.batch), const Batch<Options>&, batch::Results>,
+                     batch::Report>,
+      "batch(batch, results) -> dynid::batch::Report");
   bool ok = c.name != nullptr && c.name[0] != '\0' && c.doc != nullptr && c.doc[0] != '\0';
   for (const char* input : c.inputs) ok = ok && input != nullptr && input[0] != '\0';
   return ok;

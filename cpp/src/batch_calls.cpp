@@ -40,13 +40,16 @@ Index check_arguments(const char* function, const Model& model, const BatchWorks
                       const char* result_name, const Results& result, Index width) {
   if (ws.n() != model.n()) detail::throw_wrong_workspace(function, ws.n(), model.n());
   const Index T = inputs.begin()->second->rows();
-  for (const auto& [name, x] : inputs) check_shape(function, name, x->rows(), x->cols(), T, model.n());
+  for (const auto& [name, x] : inputs)
+    check_shape(function, name, x->rows(), x->cols(), T, model.n());
   check_shape(function, result_name, result.rows(), result.cols(), T, width);
   return T;
 }
 
 // Sample t of x (its row) as a vector.
-ConstVec row(const Samples& x, Index t) { return ConstVec(x.data() + t * x.outerStride(), x.cols()); }
+ConstVec row(const Samples& x, Index t) {
+  return ConstVec(x.data() + t * x.outerStride(), x.cols());
+}
 
 // x * 0 is 0 for finite x and NaN otherwise: one branch per sample.
 bool all_finite(const double* data, Index count) {
@@ -57,8 +60,7 @@ bool all_finite(const double* data, Index count) {
 
 // sample(thread's slot, t, result row t) for every t, each result checked while it is in cache.
 template <class Sample>
-Report per_sample(const Model& model, BatchWorkspace& ws, Index T, Results& result,
-                  Sample sample) {
+Report per_sample(const Model& model, BatchWorkspace& ws, Index T, Results& result, Sample sample) {
   const Index width = result.cols();
   std::vector<detail::BatchSlot>& slots = detail::slots(ws);
   auto work = [&](int slot, Index begin, Index end) -> Index {
@@ -110,16 +112,18 @@ Strided row_major(double* data, int rows, int cols) {
 Report rnea(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
             const Samples& qdd, Results tau) {
   const int n = model.n();
-  const Index T =
-      check_arguments("batch::rnea", model, ws, {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}}, "tau", tau, n);
+  const Index T = check_arguments("batch::rnea", model, ws, {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}},
+                                  "tau", tau, n);
   if (use_lanes(model, T, detail::kMaxBatchJoints, {&q, &qd, &qdd}, tau))
-    return lanes(model, ws, T, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                   Index b, long count) {
-      return k.rnea(bm, q.data() + b * n, qd.data() + b * n, qdd.data() + b * n,
-                    tau.data() + b * n, count);
-    });
+    return lanes(
+        model, ws, T,
+        [&](const detail::LaneKernels& k, const detail::BatchModel& bm, Index b, long count) {
+          return k.rnea(bm, q.data() + b * n, qd.data() + b * n, qdd.data() + b * n,
+                        tau.data() + b * n, count);
+        });
   return per_sample(model, ws, T, tau, [&](detail::BatchSlot& s, Index t, double* out) {
-    dynid::rnea(model, s.ws, row(q, t), row(qd, t), row(qdd, t), VectorOut(Eigen::Map<VectorX>(out, n)));
+    dynid::rnea(model, s.ws, row(q, t), row(qd, t), row(qdd, t),
+                VectorOut(Eigen::Map<VectorX>(out, n)));
   });
 }
 
@@ -127,10 +131,11 @@ Report mass_matrix(const Model& model, BatchWorkspace& ws, const Samples& q, Res
   const int n = model.n();
   const Index T = check_arguments("batch::mass_matrix", model, ws, {{"q", &q}}, "M", M, n * n);
   if (use_lanes(model, T, detail::kMaxBatchJoints, {&q}, M))
-    return lanes(model, ws, T, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                   Index b, long count) {
-      return k.mass_matrix(bm, q.data() + b * n, M.data() + b * n * n, count);
-    });
+    return lanes(
+        model, ws, T,
+        [&](const detail::LaneKernels& k, const detail::BatchModel& bm, Index b, long count) {
+          return k.mass_matrix(bm, q.data() + b * n, M.data() + b * n * n, count);
+        });
   return per_sample(model, ws, T, M, [&](detail::BatchSlot& s, Index t, double* out) {
     crba(model, s.ws, row(q, t), row_major(out, n, n));
   });
@@ -140,10 +145,11 @@ Report gravity(const Model& model, BatchWorkspace& ws, const Samples& q, Results
   const int n = model.n();
   const Index T = check_arguments("batch::gravity", model, ws, {{"q", &q}}, "g", g, n);
   if (use_lanes(model, T, detail::kMaxBatchJoints, {&q}, g))
-    return lanes(model, ws, T, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                   Index b, long count) {
-      return k.gravity(bm, q.data() + b * n, g.data() + b * n, count);
-    });
+    return lanes(
+        model, ws, T,
+        [&](const detail::LaneKernels& k, const detail::BatchModel& bm, Index b, long count) {
+          return k.gravity(bm, q.data() + b * n, g.data() + b * n, count);
+        });
   return per_sample(model, ws, T, g, [&](detail::BatchSlot& s, Index t, double* out) {
     dynid::gravity(model, s.ws, row(q, t), Eigen::Map<VectorX>(out, n));
   });
@@ -152,7 +158,8 @@ Report gravity(const Model& model, BatchWorkspace& ws, const Samples& q, Results
 Report coriolis(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
                 Results c) {
   const int n = model.n();
-  const Index T = check_arguments("batch::coriolis", model, ws, {{"q", &q}, {"qd", &qd}}, "c", c, n);
+  const Index T =
+      check_arguments("batch::coriolis", model, ws, {{"q", &q}, {"qd", &qd}}, "c", c, n);
   return per_sample(model, ws, T, c, [&](detail::BatchSlot& s, Index t, double* out) {
     dynid::coriolis(model, s.ws, row(q, t), row(qd, t), Eigen::Map<VectorX>(out, n));
   });
@@ -176,8 +183,8 @@ Report friction(const Model& model, BatchWorkspace& ws, const Samples& qd, Resul
   });
 }
 
-Report forward_dynamics(const Model& model, BatchWorkspace& ws, const Samples& q,
-                        const Samples& qd, const Samples& tau, Results qdd) {
+Report forward_dynamics(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
+                        const Samples& tau, Results qdd) {
   const int n = model.n();
   const Index T = check_arguments("batch::forward_dynamics", model, ws,
                                   {{"q", &q}, {"qd", &qd}, {"tau", &tau}}, "qdd", qdd, n);
@@ -196,8 +203,7 @@ Report kinetic_energy(const Model& model, BatchWorkspace& ws, const Samples& q, 
   });
 }
 
-Report potential_energy(const Model& model, BatchWorkspace& ws, const Samples& q,
-                        Results energy) {
+Report potential_energy(const Model& model, BatchWorkspace& ws, const Samples& q, Results energy) {
   const Index T =
       check_arguments("batch::potential_energy", model, ws, {{"q", &q}}, "energy", energy, 1);
   return per_sample(model, ws, T, energy, [&](detail::BatchSlot& s, Index t, double* out) {
@@ -236,11 +242,12 @@ Report regressor(const Model& model, BatchWorkspace& ws, const Samples& q, const
   const Index T = check_arguments("batch::regressor", model, ws,
                                   {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}}, "Y", Y, Index{n} * P);
   if (use_lanes(model, T, detail::kMaxRegressorLaneJoints, {&q, &qd, &qdd}, Y))
-    return lanes(model, ws, T, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                   Index b, long count) {
-      return k.regressor(bm, q.data() + b * n, qd.data() + b * n, qdd.data() + b * n, rotor,
-                         friction, nullptr, P, Y.data() + b * n * P, count);
-    });
+    return lanes(
+        model, ws, T,
+        [&](const detail::LaneKernels& k, const detail::BatchModel& bm, Index b, long count) {
+          return k.regressor(bm, q.data() + b * n, qd.data() + b * n, qdd.data() + b * n, rotor,
+                             friction, nullptr, P, Y.data() + b * n * P, count);
+        });
   return per_sample(model, ws, T, Y, [&](detail::BatchSlot& s, Index t, double* out) {
     dynid::regressor(model, s.ws, row(q, t), row(qd, t), row(qdd, t), rotor, friction,
                      RowMap(out, n, P));
@@ -253,7 +260,8 @@ Report regressor(const Model& model, BatchWorkspace& ws, const Samples& q, const
   const int n = model.n(), P = regressor_columns(n, rotor, friction);
   const int C = static_cast<int>(columns.size());
   if (C == 0)
-    throw std::invalid_argument("columns: expected at least one column (in dynid::batch::regressor)");
+    throw std::invalid_argument(
+        "columns: expected at least one column (in dynid::batch::regressor)");
   for (int k = 0; k < C; ++k)
     if (columns[k] < 0 || columns[k] >= P)
       throw std::invalid_argument("columns: expected indices in [0, " + std::to_string(P) +
@@ -262,11 +270,12 @@ Report regressor(const Model& model, BatchWorkspace& ws, const Samples& q, const
   const Index T = check_arguments("batch::regressor", model, ws,
                                   {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}}, "Y", Y, Index{n} * C);
   if (use_lanes(model, T, detail::kMaxRegressorLaneJoints, {&q, &qd, &qdd}, Y))
-    return lanes(model, ws, T, [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                                   Index b, long count) {
-      return k.regressor(bm, q.data() + b * n, qd.data() + b * n, qdd.data() + b * n, rotor,
-                         friction, columns.data(), C, Y.data() + b * n * C, count);
-    });
+    return lanes(
+        model, ws, T,
+        [&](const detail::LaneKernels& k, const detail::BatchModel& bm, Index b, long count) {
+          return k.regressor(bm, q.data() + b * n, qd.data() + b * n, qdd.data() + b * n, rotor,
+                             friction, columns.data(), C, Y.data() + b * n * C, count);
+        });
   // Each sample's full regressor goes to its thread's buffer (in cache) and the selected
   // columns are copied out of it; the buffers are sized here, before any thread starts.
   std::vector<detail::BatchSlot>& slots = detail::slots(ws);
@@ -276,7 +285,8 @@ Report regressor(const Model& model, BatchWorkspace& ws, const Samples& q, const
     RowMap Yfull(full.data(), n, P);
     dynid::regressor(model, s.ws, row(q, t), row(qd, t), row(qdd, t), rotor, friction, Yfull);
     for (int i = 0; i < n; ++i)
-      for (int k = 0; k < C; ++k) out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
+      for (int k = 0; k < C; ++k)
+        out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
   });
 }
 
@@ -299,8 +309,8 @@ Report inertia_regressor(const Model& model, BatchWorkspace& ws, const Samples& 
   });
 }
 
-Report rnea_derivatives(const Model& model, BatchWorkspace& ws, const Samples& q,
-                        const Samples& qd, const Samples& qdd, Results dtau) {
+Report rnea_derivatives(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
+                        const Samples& qdd, Results dtau) {
   const int n = model.n();
   const Index T = check_arguments("batch::rnea_derivatives", model, ws,
                                   {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}}, "dtau", dtau, 2 * n * n);
@@ -314,10 +324,10 @@ Report rnea_time_derivatives(const Model& model, BatchWorkspace& ws, const Sampl
                              const Samples& qd, const Samples& qdd, const Samples& qddd,
                              const Samples& qdddd, Results tau) {
   const int n = model.n();
-  const Index T = check_arguments(
-      "batch::rnea_time_derivatives", model, ws,
-      {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}, {"qddd", &qddd}, {"qdddd", &qdddd}}, "tau", tau,
-      3 * n);
+  const Index T =
+      check_arguments("batch::rnea_time_derivatives", model, ws,
+                      {{"q", &q}, {"qd", &qd}, {"qdd", &qdd}, {"qddd", &qddd}, {"qdddd", &qdddd}},
+                      "tau", tau, 3 * n);
   return per_sample(model, ws, T, tau, [&](detail::BatchSlot& s, Index t, double* out) {
     Eigen::Map<VectorX> tau0(out, n), tau1(out + n, n), tau2(out + 2 * n, n);
     dynid::rnea_time_derivatives(model, s.ws, row(q, t), row(qd, t), row(qdd, t), row(qddd, t),

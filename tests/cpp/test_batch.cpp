@@ -160,8 +160,9 @@ void check_against_single_calls(const dynid::Model& model, Index T, std::mt19937
   });
   expect_rows(path + "potential_energy", U,
               [&](Index t, double* o) { *o = dynid::potential_energy(model, w, sample(Q, t)); });
-  expect_rows(path + "fkine", pose,
-              [&](Index t, double* o) { dynid::fkine(model, w, sample(Q, t), row_major(o, 4, 4)); });
+  expect_rows(path + "fkine", pose, [&](Index t, double* o) {
+    dynid::fkine(model, w, sample(Q, t), row_major(o, 4, 4));
+  });
   expect_rows(path + "jacobian", J, [&](Index t, double* o) {
     dynid::jacobian(model, w, sample(Q, t), row_major(o, 6, n));
   });
@@ -211,8 +212,8 @@ bool check_threads(const dynid::Model& model, std::mt19937_64& rng) {
   const dynid::batch::Report rc = dynid::batch::coriolis(model, pair, Q, Qd, c2);
   // Each sample is computed by the same code whichever thread runs it: bit-identical.
   if (r.threads != 2 || rc.threads != 2 || one != two || c1 != c2) {
-    std::printf("FAIL threads: %d and %d threads, equal %d %d\n", r.threads, rc.threads,
-                one == two, c1 == c2);
+    std::printf("FAIL threads: %d and %d threads, equal %d %d\n", r.threads, rc.threads, one == two,
+                c1 == c2);
     return false;
   }
   return true;
@@ -241,8 +242,8 @@ bool check_errors(const dynid::Model& model) {
   ok &= names_argument("columns", [&] {
     batch::regressor(model, ws, q, q, q, false, false, std::vector<int>{0, 10 * n}, Y);
   });
-  ok &= names_argument("columns",
-                       [&] { batch::regressor(model, ws, q, q, q, false, false, {}, Y); });
+  ok &=
+      names_argument("columns", [&] { batch::regressor(model, ws, q, q, q, false, false, {}, Y); });
   ok &= names_argument("qdddd", [&] {
     RowMajorMatrixX out(T, 3 * n);
     batch::rnea_time_derivatives(model, ws, q, q, q, q, narrow, out);

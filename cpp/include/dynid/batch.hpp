@@ -110,13 +110,12 @@ Report coriolis_matrix(const Model& model, BatchWorkspace& ws, const Samples& q,
 // T x n: friction.hpp.
 Report friction(const Model& model, BatchWorkspace& ws, const Samples& qd, Results tau);
 // T x n: forward_dynamics.hpp.
-Report forward_dynamics(const Model& model, BatchWorkspace& ws, const Samples& q,
-                        const Samples& qd, const Samples& tau, Results qdd);
+Report forward_dynamics(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
+                        const Samples& tau, Results qdd);
 // T x 1: energy.hpp.
 Report kinetic_energy(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
                       Results energy);
-Report potential_energy(const Model& model, BatchWorkspace& ws, const Samples& q,
-                        Results energy);
+Report potential_energy(const Model& model, BatchWorkspace& ws, const Samples& q, Results energy);
 // T x 16 (4 x 4 poses) and T x 6n (6 x n Jacobians): kinematics.hpp.
 Report fkine(const Model& model, BatchWorkspace& ws, const Samples& q, Results T);
 Report jacobian(const Model& model, BatchWorkspace& ws, const Samples& q, Results J);
@@ -135,8 +134,8 @@ Report gravity_regressor(const Model& model, BatchWorkspace& ws, const Samples& 
 Report inertia_regressor(const Model& model, BatchWorkspace& ws, const Samples& q, bool rotor,
                          Results Ym);
 // T x 2n*n: row t holds dtau/dq then dtau/dqd, each n x n row by row (rnea_derivatives.hpp).
-Report rnea_derivatives(const Model& model, BatchWorkspace& ws, const Samples& q,
-                        const Samples& qd, const Samples& qdd, Results dtau);
+Report rnea_derivatives(const Model& model, BatchWorkspace& ws, const Samples& q, const Samples& qd,
+                        const Samples& qdd, Results dtau);
 // T x 3n: row t holds tau, tau_dot, tau_ddot (rnea_time_derivatives.hpp).
 Report rnea_time_derivatives(const Model& model, BatchWorkspace& ws, const Samples& q,
                              const Samples& qd, const Samples& qdd, const Samples& qddd,
