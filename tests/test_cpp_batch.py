@@ -10,7 +10,6 @@ from __future__ import annotations
 import re
 
 from cpp_programs import CppTests
-
 from dynid import _core
 
 
