@@ -10,7 +10,6 @@
 #include <string>
 
 #include "call_table.hpp"
-#include "dynid/detail/batch_runner.hpp"
 #include "fast_path.hpp"
 #include "without_gil.hpp"
 
@@ -92,10 +91,7 @@ auto evaluate(PyModel& self, const std::array<py::handle, kInputs<K>>& input,
     }
     // The model snapshot stays alive while the batch runs without the GIL.
     const std::shared_ptr<const Model> model = self.model;
-    // Workspaces for the threads the batch will use (dynid.set_threads; batch_runner.hpp).
-    const py::ssize_t threads = std::min<py::ssize_t>(
-        batch_threads(), std::max<py::ssize_t>(1, s.count / detail::kMinSamplesPerThread));
-    BatchWorkspace ws(*model, static_cast<int>(threads));
+    BatchWorkspace ws(*model, batch_workspace_threads(s.count));
     ws.set_interrupt(python_interrupt());
     const std::array<Eigen::Map<const RowMajorMatrixX>, kInputs<K>> samples{
         Eigen::Map<const RowMajorMatrixX>(s.data[I], s.count, n)...};
