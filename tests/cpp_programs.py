@@ -34,6 +34,7 @@ PROGRAMS = (
     "elastic_no_allocation",
     "transmission_no_allocation",
     "uses_no_allocation",
+    "batch",
     "realtime_loop",
 )
 

@@ -1,7 +1,8 @@
-"""The vectorcall fast path of the single-sample calls (fast_calls.cpp)
-against the full pybind11 methods it bypasses (kept as Model._<name>_full): bit-identical
-results for the inputs it takes, and for every other input (keywords, out=, lists, other dtypes,
-layouts, shapes, NaN, batches) the full method's result or error, unchanged."""
+"""The vectorcall fast path of the single-sample calls (cpp/bindings/calls.cpp, generated for
+every entry of cpp/bindings/call_table.hpp) against the full pybind11 methods it bypasses (kept
+as Model._<name>_full): bit-identical results for the inputs it takes, and for every other input
+(keywords, out=, lists, other dtypes, layouts, shapes, NaN, batches) the full method's result or
+error, unchanged."""
 
 from __future__ import annotations
 
@@ -28,15 +29,37 @@ CALLS = {
     "regressor": ("q", "qd", "qdd"),
     "gravity_regressor": ("q",),
     "inertia_regressor": ("q",),
+    "jacobian_dot": ("q", "qd"),
+    "rnea_derivatives": ("q", "qd", "qdd"),
+    "rnea_time_derivatives": ("q", "qd", "qdd", "qddd", "qdddd"),
 }
 ENERGIES = ("kinetic_energy", "potential_energy")
+# Tuples of views into one array; no out=.
+PARTS = ("rnea_derivatives", "rnea_time_derivatives")
+NO_OUT = (*ENERGIES, *PARTS, "jacobian_dot")
 
 
 def setup():
     arm = make_arm("random_standard")
     q, qd, qdd = random_state(np.random.default_rng(4), arm)
     robot = arm.robot()
-    return robot, {"q": q, "qd": qd, "qdd": qdd, "tau": robot.rnea(q, qd, qdd)}
+    rng = np.random.default_rng(5)
+    return robot, {
+        "q": q,
+        "qd": qd,
+        "qdd": qdd,
+        "qddd": rng.uniform(-3.0, 3.0, robot.n),
+        "qdddd": rng.uniform(-3.0, 3.0, robot.n),
+        "tau": robot.rnea(q, qd, qdd),
+    }
+
+
+def test_every_call_of_the_table_has_a_fast_path_and_is_tested() -> None:
+    # The table (call_table.hpp) generates Model.<name> and Model._<name>_full for each entry.
+    full = {name[1:-5] for name in vars(_core.Model) if name.endswith("_full")}
+    assert full == set(CALLS)
+    for name in CALLS:
+        assert type(vars(_core.Model)[name]).__name__ == "method_descriptor", name
 
 
 @pytest.mark.parametrize("call", sorted(CALLS))
@@ -47,6 +70,12 @@ def test_fast_path_equals_full_method(call: str) -> None:
     full = getattr(_core.Model, f"_{call}_full")(robot, *args)
     if call in ENERGIES:
         assert type(fast) is float and fast == full
+        return
+    if call in PARTS:
+        assert type(fast) is tuple and len(fast) == len(full)
+        for part, expected in zip(fast, full):
+            np.testing.assert_array_equal(part, expected)
+            assert part.base is fast[0].base and part.base.shape == (len(full), *part.shape)
         return
     assert type(fast) is np.ndarray and fast.dtype == np.float64 and fast.flags.c_contiguous
     np.testing.assert_array_equal(fast, full)
@@ -70,11 +99,15 @@ def test_other_inputs_take_the_full_path(call: str) -> None:
         np.testing.assert_array_equal(getattr(robot, call)(*variant), full(robot, *variant))
     by_keyword = getattr(robot, call)(**dict(zip(names, args)))
     np.testing.assert_array_equal(by_keyword, expected)
-    if call not in ENERGIES:
+    if call not in NO_OUT:
         out = np.empty_like(expected)
         assert getattr(robot, call)(*args, out=out) is out
     batch = getattr(robot, call)(*[np.stack([a, a]) for a in args])
-    np.testing.assert_allclose(batch[1], expected, rtol=1e-12, atol=1e-12)  # lane kernels
+    if call in PARTS:  # each part (2, ...): its second sample
+        batch, expected = np.stack([part[1] for part in batch]), np.stack(expected)
+    else:
+        batch = batch[1]
+    np.testing.assert_allclose(batch, expected, rtol=1e-12, atol=1e-12)  # lane kernels
 
 
 @pytest.mark.parametrize("call", sorted(CALLS))

@@ -1,5 +1,5 @@
-// Binding of the C++ parts of the elastic-joint model (SPEC section 8, last bullet): the exact
-// time derivatives of inverse dynamics that its flat-output inverse dynamics needs.
+// Binding of the elastic-joint simulator (SPEC section 8, last bullet; the exact time derivatives
+// of inverse dynamics are the Model call rnea_time_derivatives of call_table.hpp).
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -8,7 +8,7 @@ namespace dynid::binding {
 
 namespace py = pybind11;
 
-// After bind_model: adds rnea_time_derivatives to m.Model.
+// _simulate_elastic and _simulate_elastic_kuka (after bind_model: they take Models).
 void bind_elastic(py::module_& m);
 
 }  // namespace dynid::binding

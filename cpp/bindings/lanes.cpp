@@ -1,6 +1,11 @@
 // Python access to the batch path selection (tests run every path the CPU supports).
 #include "lanes.hpp"
 
+#include <stdexcept>
+#include <string>
+
+#include "arrays.hpp"
+#include "dynid/detail/batch.hpp"
 #include "result_pool.hpp"
 
 namespace dynid::binding {

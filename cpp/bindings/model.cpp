@@ -1,9 +1,8 @@
-// Binding of the Model: construction from a DH table, parameters and drive terms, and the
-// per-sample dynamics calls (single sample or a batch looped in C++).
+// Binding of the Model: construction from a DH table, parameters and drive terms; its dynamics
+// calls come from call_table.hpp (calls.cpp).
 #include "model.hpp"
 
-#include "lanes.hpp"
-#include "per_sample.hpp"
+#include "calls.hpp"
 
 #include <atomic>
 #include <cctype>
@@ -66,11 +65,6 @@ VectorX parse_drive(py::handle obj, const char* name, int n) {
   Array a = parse_fixed(obj, name, {n});
   return ConstVec(a.data(), n);
 }
-
-// Output shapes per sample (per_sample.hpp has the common ones).
-std::vector<py::ssize_t> pose(int) { return {4, 4}; }
-std::vector<py::ssize_t> twist_by_joint(int n) { return {6, n}; }
-std::vector<py::ssize_t> joint_by_link_parameters(int n) { return {n, 10 * n}; }
 
 }  // namespace
 
@@ -277,157 +271,7 @@ void bind_model(py::module_& m) {
           [](const PyModel& self, int i) { return self.model->link_inconsistency(i); },
           "Why link i (0-based) is not physically consistent, or '' when it is.");
 
-  // The per-sample dynamics: inputs, output shape per sample, core call (per_sample.hpp).
-  def_per_sample(
-      model, "rnea", {"q", "qd", "qdd"}, per_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, ConstVec qdd, double* tau) {
-        rnea(m, ws, q, qd, qdd, OutVec(tau, m.n()));
-      },
-      "Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler); with a "
-      "transmission T the friction is T^T (Fv T qd + Fs sign(T qd)).",
-      &detail::LaneKernels::rnea);
-  def_per_sample(
-      model, "mass_matrix", {"q"}, joint_by_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, double* M) {
-        crba(m, ws, q, row_major(M, m.n(), m.n()));
-      },
-      "Joint-space inertia matrix M(q) = B(q) + diag(Ia) (CRBA); T^T diag(Ia) T with a "
-      "transmission T.",
-      &detail::LaneKernels::mass_matrix);
-  def_per_sample(
-      model, "gravity", {"q"}, per_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, double* g) {
-        gravity(m, ws, q, OutVec(g, m.n()));
-      },
-      "Gravity torques g(q).", &detail::LaneKernels::gravity);
-  def_per_sample(
-      model, "coriolis", {"q", "qd"}, per_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, double* c) {
-        coriolis(m, ws, q, qd, OutVec(c, m.n()));
-      },
-      "Coriolis and centrifugal torques c(q, qd).");
-  def_per_sample(
-      model, "coriolis_matrix", {"q", "qd"}, joint_by_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, double* S) {
-        coriolis_matrix(m, ws, q, qd, row_major(S, m.n(), m.n()));
-      },
-      "Coriolis matrix S(q, qd) from the Christoffel symbols: c = S qd, Mdot - 2S "
-      "skew-symmetric.");
-  def_per_sample(
-      model, "friction", {"qd"}, per_joint,
-      [](const Model& m, Workspace&, ConstVec qd, double* tau) {
-        friction(m, qd, OutVec(tau, m.n()));
-      },
-      "Joint friction Fv qd + Fs sign(qd); T^T (Fv T qd + Fs sign(T qd)) with a transmission T.");
-  // M(q) not positive definite (a std::domain_error) is a ValueError about the parameters.
-  def_per_sample<DomainError::Params>(
-      model, "forward_dynamics", {"q", "qd", "tau"}, per_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd, ConstVec tau, double* qdd) {
-        forward_dynamics(m, ws, q, qd, tau, OutVec(qdd, m.n()));
-      },
-      "Joint accelerations for the torques tau.");
-  def_per_sample(
-      model, "kinetic_energy", {"q", "qd"}, scalar,
-      [](const Model& m, Workspace& ws, ConstVec q, ConstVec qd) {
-        return kinetic_energy(m, ws, q, qd);
-      },
-      "Kinetic energy 1/2 qd^T M(q) qd (rotors included).");
-  def_per_sample(
-      model, "potential_energy", {"q"}, scalar,
-      [](const Model& m, Workspace& ws, ConstVec q) { return potential_energy(m, ws, q); },
-      "Gravity potential energy -sum m_i g^T p_ci (zero at the world origin).");
-  def_per_sample(
-      model, "fkine", {"q"}, pose,
-      [](const Model& m, Workspace& ws, ConstVec q, double* T) {
-        fkine(m, ws, q, row_major(T, 4, 4));
-      },
-      "World pose (4, 4) of the tool: base A_1 ... A_n tool.");
-  def_per_sample(
-      model, "jacobian", {"q"}, twist_by_joint,
-      [](const Model& m, Workspace& ws, ConstVec q, double* J) {
-        jacobian(m, ws, q, row_major(J, 6, m.n()));
-      },
-      "Geometric Jacobian (6, n) of the tool point in world axes, rows [v; omega].");
-
-  // The regressor keeps its own definition: flags, a column selection and the lane kernel's
-  // joint limit change its shape and kernel.
-  model.def(
-      "regressor",
-      [](PyModel& self, py::handle q, py::handle qd, py::handle qdd, py::handle rotor_flag,
-         py::handle friction_flag, py::handle columns_arg, py::handle out) {
-        const bool rotor = parse_flag(rotor_flag, "rotor");
-        const bool friction = parse_flag(friction_flag, "friction");
-        const int n = self.model->n();
-        const int P = regressor_columns(n, rotor, friction);
-        const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
-        const std::vector<int> columns =
-            columns_arg.is_none() ? std::vector<int>() : parse_columns(columns_arg, P);
-        const int C = columns.empty() ? P : static_cast<int>(columns.size());
-        if (use_lanes(self, s, detail::kMaxRegressorLaneJoints))
-          return evaluate_lanes(
-              self, s, {n, C},
-              [&](const detail::LaneKernels& k, const detail::BatchModel& bm,
-                  const double* const* in, double* out, long T) {
-                return k.regressor(bm, in[0], in[1], in[2], rotor, friction,
-                                   columns.empty() ? nullptr : columns.data(), C, out, T);
-              },
-              out);
-        if (columns_arg.is_none())
-          return evaluate(
-              self, s, {n, P},
-              [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-                RowMajorMap Y(out, n, P);
-                regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor,
-                          friction, Y);
-              },
-              out);
-        // Only the selected columns (e.g. the base parameters'): each sample's full regressor
-        // goes to a per-thread buffer in cache and the columns are copied out of it.
-        return evaluate(
-            self, s, {n, C},
-            [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              thread_local std::vector<double> full;
-              full.resize(static_cast<std::size_t>(n) * P);
-              RowMajorMap Y(full.data(), n, P);
-              regressor(m, ws, ConstVec(in[0], n), ConstVec(in[1], n), ConstVec(in[2], n), rotor,
-                        friction, Y);
-              for (int i = 0; i < n; ++i)
-                for (int k = 0; k < C; ++k)
-                  out[i * C + k] = full[static_cast<std::size_t>(i) * P + columns[k]];
-            },
-            out);
-      },
-      py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("rotor") = false,
-      py::arg("friction") = false, py::arg("columns") = py::none(), py::arg("out") = py::none(),
-      "Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; "
-      "with "
-      "columns (indices into the P columns, e.g. base_parameters(...).independent) only those, "
-      "(n, len(columns)); out: a preallocated float64 result array of the exact shape.");
-  def_per_sample(
-      model, "gravity_regressor", {"q"}, joint_by_link_parameters,
-      [](const Model& m, Workspace& ws, ConstVec q, double* Y) {
-        gravity_regressor(m, ws, q, RowMajorMap(Y, m.n(), 10 * m.n()));
-      },
-      "Gravity regressor Y_g (n, 10n) with Y_g @ pi == gravity(q) (paper eq. (17)).");
-  // The inertia regressor's rotor flag changes its shape.
-  model.def(
-      "inertia_regressor",
-      [](PyModel& self, py::handle q, py::handle rotor_flag, py::handle out) {
-        const bool rotor = parse_flag(rotor_flag, "rotor");
-        const int n = self.model->n();
-        const int rows = n * (n + 1) / 2, P = 10 * n + (rotor ? n : 0);
-        const Samples s = parse_samples({{q, "q"}}, n);
-        return evaluate(
-            self, s, {rows, P},
-            [=](const Model& m, Workspace& ws, const double* const* in, double* out) {
-              RowMajorMap Y(out, rows, P);
-              inertia_regressor(m, ws, ConstVec(in[0], n), rotor, Y);
-            },
-            out);
-      },
-      py::arg("q"), py::arg("rotor") = false, py::arg("out") = py::none(),
-      "Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] "
-      "(links only, or with the rotor columns the full M) (paper eq. (18)).");
+  bind_calls(model);  // rnea, mass_matrix, ...: call_table.hpp
 }
 
 }  // namespace dynid::binding

@@ -5,15 +5,14 @@
 
 #include <algorithm>
 #include <atomic>
-#include <exception>
 #include <memory>
-#include <thread>
 #include <vector>
 
 #include "arrays.hpp"
-#include "batch.hpp"
+#include "dynid/detail/batch_runner.hpp"
 #include "dynid/dynid.hpp"
 #include "initialised.hpp"
+#include "without_gil.hpp"
 
 namespace dynid::binding {
 
@@ -58,15 +57,19 @@ void set_batch_threads(int threads);
 // Threads the last batch call ran on (for tests of the splitting).
 extern std::atomic<int> last_batch_threads;
 
-// Below this many samples per thread a batch runs on one thread: starting a thread costs about
-// as much as a few hundred samples.
-constexpr py::ssize_t kMinSamplesPerThread = 512;
+// The workspaces a batch of `count` samples needs: one per thread it will run on
+// (dynid.set_threads; fewer below detail::kMinSamplesPerThread samples per thread).
+inline int batch_workspace_threads(py::ssize_t count) {
+  return static_cast<int>(std::min<py::ssize_t>(
+      batch_threads(), std::max<py::ssize_t>(1, count / detail::kMinSamplesPerThread)));
+}
 
-// Runs kernel(model, workspace, inputs, output) on one sample, or on each of T samples in C++
-// with the GIL released, split over batch_threads() threads each with its own Workspace
-// (run_batch: interruptible by Ctrl-C, fewer threads when the system refuses some); the output
-// has shape `tail` or (T, *tail) and is `out` when given (output_array). Each sample's output is
-// checked for finiteness right after it is written, while it is in cache.
+// For per-sample calls that are not Model methods of call_table.hpp (e.g. laws.cpp):
+// kernel(model, workspace, inputs (n values each), output) on one sample with the model's
+// workspace, or on each of T samples through the core's batch loop (detail::run_chunks: the
+// threads of dynid.set_threads, each with its own workspace; Ctrl-C) without the GIL. The output
+// has shape `tail` or (T, *tail) and is `out` when given (output_array); each sample's output is
+// checked for finiteness right after it is written.
 template <class Kernel>
 py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tail, Kernel kernel,
                    py::handle out_arg = py::none()) {
@@ -76,40 +79,37 @@ py::array evaluate(PyModel& self, const Samples& s, std::vector<py::ssize_t> tai
   if (!s.single) tail.insert(tail.begin(), s.count);
   py::array_t<double> out = output_array(out_arg, tail);
   double* out_data = out.mutable_data();
-  const std::size_t arguments = s.size;
   if (s.single) {
     const double* in[Samples::kMaxArguments] = {};
-    for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, 0, n);
+    for (std::size_t k = 0; k < s.size; ++k) in[k] = s.row(k, 0, n);
     kernel(*self.model, *self.ws, in, out_data);
     if (!all_finite(out_data, per_sample))
       require_finite_result(out_data, per_sample, s.names.c_str());
     return out;
   }
-  std::shared_ptr<const Model> model = self.model;
-  const int threads = static_cast<int>(std::max<py::ssize_t>(
-      1, std::min<py::ssize_t>(batch_threads(), s.count / kMinSamplesPerThread)));
-  // One worker per thread, with its own Workspace (batch.hpp: chunks, Ctrl-C, thread failures).
-  std::atomic<py::ssize_t> first_bad{s.count};  // the first sample with a non-finite output
-  auto make_worker = [&] {
-    return [&, ws = Workspace(*model)](py::ssize_t begin, py::ssize_t end) mutable {
-      const double* in[Samples::kMaxArguments] = {};
-      for (py::ssize_t t = begin; t < end; ++t) {
-        for (std::size_t k = 0; k < arguments; ++k) in[k] = s.row(k, t, n);
-        double* sample = out_data + t * per_sample;
-        kernel(*model, ws, in, sample);
-        if (!all_finite(sample, per_sample)) {
-          py::ssize_t seen = first_bad.load();
-          while (t < seen && !first_bad.compare_exchange_weak(seen, t)) {
-          }
-          return;
-        }
-      }
-    };
+  const std::shared_ptr<const Model> model = self.model;  // alive while the GIL is released
+  BatchWorkspace ws(*model, batch_workspace_threads(s.count));
+  std::vector<detail::BatchSlot>& slots = detail::slots(ws);
+  auto work = [&](int slot, Eigen::Index begin, Eigen::Index end) -> Eigen::Index {
+    Workspace& w = slots[static_cast<std::size_t>(slot)].ws;
+    const double* in[Samples::kMaxArguments] = {};
+    for (Eigen::Index t = begin; t < end; ++t) {
+      for (std::size_t k = 0; k < s.size; ++k) in[k] = s.row(k, t, n);
+      double* sample = out_data + t * per_sample;
+      kernel(*model, w, in, sample);
+      if (!all_finite(sample, per_sample)) return t;
+    }
+    return -1;
   };
-  const double work = std::max<double>(static_cast<double>(n) * n, static_cast<double>(per_sample));
-  last_batch_threads = run_batch(s.count, threads, make_worker, chunk_for_work(work));
-  if (first_bad < s.count)
-    require_finite_result(out_data + first_bad * per_sample, per_sample, s.names.c_str());
+  const double cost = std::max<double>(static_cast<double>(n) * n, static_cast<double>(per_sample));
+  const batch::Report report = without_gil([&] {
+    return detail::run_chunks(s.count, detail::batch_threads(ws, s.count),
+                              detail::chunk_for_work(cost), work, python_interrupt());
+  });
+  last_batch_threads = report.threads;
+  if (report.first_nonfinite >= 0)
+    require_finite_result(out_data + report.first_nonfinite * per_sample, per_sample,
+                          s.names.c_str());
   return out;
 }
 

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "elastic.hpp"
-#include "fast_calls.hpp"
 #include "lanes.hpp"
 #include "laws.hpp"
 #include "model.hpp"
@@ -18,9 +17,8 @@ namespace py = pybind11;
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "dynid C++ core (use the dynid package, not this module)";
-  dynid::binding::bind_model(m);
-  dynid::binding::bind_uses(m);  // adds methods to Model: after bind_model
-  // adds rnea_time_derivatives to Model (after bind_model) and the elastic simulator
+  dynid::binding::bind_model(m);  // Model and its calls (call_table.hpp); first: others take Models
+  dynid::binding::bind_uses(m);
   dynid::binding::bind_elastic(m);
   dynid::binding::bind_lanes(m);
   dynid::binding::bind_recursive_least_squares(m);
@@ -56,6 +54,4 @@ PYBIND11_MODULE(_core, m) {
       py::arg("mass"), py::arg("inertia_com"),
       "Why a body of this mass and inertia about its centre of mass cannot exist ('' if it can).");
   dynid::binding::add_text_signatures(m);  // after every function is defined
-  // Last: the fast methods take the pybind11 methods' docstrings with their text signatures.
-  dynid::binding::bind_fast_calls(m);
 }

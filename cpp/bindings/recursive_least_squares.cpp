@@ -11,9 +11,10 @@
 #include <string>
 
 #include "arrays.hpp"
-#include "batch.hpp"
+#include "dynid/detail/batch_runner.hpp"
 #include "dynid/recursive_least_squares.hpp"
 #include "object_lock.hpp"
+#include "without_gil.hpp"
 
 namespace dynid::binding {
 namespace {
@@ -177,24 +178,23 @@ py::array update_batch(RLS& rls, py::handle Y_obj, py::handle tau_obj, py::handl
   const double* Y_data = Y.data();
   const double* tau_data = tau.data();
   const auto lock = lock_object(&rls);  // the whole batch, one thread at a time
-  // The updates are sequential: one thread, chunks of blocks between Ctrl-C checks (batch.hpp).
-  // An interrupted or overflowing batch leaves the estimator as it was before the call.
+  // The updates are sequential: one thread, chunks of blocks between Ctrl-C checks
+  // (without_gil.hpp). An interrupted or overflowing batch leaves the estimator as it was before
+  // the call.
   const RLS before = rls;
+  auto updates = [&](int, Eigen::Index begin, Eigen::Index end) -> Eigen::Index {
+    for (Eigen::Index t = begin; t < end; ++t) {
+      rls.update(block(Y_data + t * m * p, m, p), Eigen::Map<const VectorX>(tau_data + t * m, m));
+      if (history)
+        std::memcpy(out + t * p, rls.theta().data(), sizeof(double) * static_cast<std::size_t>(p));
+    }
+    return -1;  // the state's finiteness is checked at the end
+  };
   try {
-    run_batch(
-        T, 1,
-        [&] {
-          return [&](py::ssize_t begin, py::ssize_t end) {
-            for (py::ssize_t t = begin; t < end; ++t) {
-              rls.update(block(Y_data + t * m * p, m, p),
-                         Eigen::Map<const VectorX>(tau_data + t * m, m));
-              if (history)
-                std::memcpy(out + t * p, rls.theta().data(),
-                            sizeof(double) * static_cast<std::size_t>(p));
-            }
-          };
-        },
-        chunk_for_work(static_cast<double>(m) * p * p, 4e6));
+    without_gil([&] {
+      return detail::run_chunks(T, 1, detail::chunk_for_work(static_cast<double>(m) * p * p, 4e6),
+                                updates, python_interrupt());
+    });
   } catch (...) {
     rls = before;
     throw;

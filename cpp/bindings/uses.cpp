@@ -1,6 +1,5 @@
-// Binding of SPEC section 8's C++ parts: rnea_derivatives and jacobian_dot (registered onto the
-// Model class of model.cpp, single sample or a batch looped in C++ by evaluate()) and the
-// MomentumObserver (update per sample, run over a log with the GIL released).
+// Binding of the MomentumObserver of SPEC section 8 (update per sample, run over a log with the
+// GIL released); section 8's rnea_derivatives and jacobian_dot are entries of call_table.hpp.
 #include "uses.hpp"
 
 #include <memory>
@@ -42,47 +41,6 @@ py::array vector_copy(const VectorX& v) {
 }  // namespace
 
 void bind_uses(py::module_& m) {
-  auto model = py::reinterpret_borrow<py::class_<PyModel>>(m.attr("Model"));
-  model.def(
-      "rnea_derivatives",
-      [](PyModel& self, py::handle q, py::handle qd, py::handle qdd) {
-        const int n = self.model->n();
-        const Samples s = parse_samples({{q, "q"}, {qd, "qd"}, {qdd, "qdd"}}, n);
-        // Both matrices of a sample side by side: out[..., 0, :, :] = dtau/dq, [..., 1] = dtau/dqd.
-        py::array both =
-            evaluate(self, s, {2, n, n},
-                     [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
-                       OutMat dq = row_major(out, n, n), dqd = row_major(out + n * n, n, n);
-                       rnea_derivatives(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n),
-                                        ConstVec(in[2], n), dq, dqd);
-                     });
-        py::object index0 =
-            s.single ? py::object(py::int_(0))
-                     : py::object(py::make_tuple(py::ellipsis(), 0, py::slice(), py::slice()));
-        py::object index1 =
-            s.single ? py::object(py::int_(1))
-                     : py::object(py::make_tuple(py::ellipsis(), 1, py::slice(), py::slice()));
-        // py::array, not the item accessors: pybind11 puts the C++ type names in the signature.
-        return py::make_tuple(py::array(both[index0]), py::array(both[index1]));
-      },
-      py::arg("q"), py::arg("qd"), py::arg("qdd"),
-      "Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, "
-      "n, n) each for T samples (Carpentier & Mansard 2018); dtau_dqd includes diag(Fv), dtau/dqdd "
-      "is mass_matrix(q). Both are views into one (2, n, n) or (T, 2, n, n) array.");
-  model.def(
-      "jacobian_dot",
-      [](PyModel& self, py::handle q, py::handle qd) {
-        const int n = self.model->n();
-        const Samples s = parse_samples({{q, "q"}, {qd, "qd"}}, n);
-        return evaluate(self, s, {6, n},
-                        [n](const Model& mdl, Workspace& ws, const double* const* in, double* out) {
-                          OutMat Jdot = row_major(out, 6, n);
-                          jacobian_dot(mdl, ws, ConstVec(in[0], n), ConstVec(in[1], n), Jdot);
-                        });
-      },
-      py::arg("q"), py::arg("qd"),
-      "Time derivative (6, n) of jacobian(q) along qd: tool point, world axes, rows [v; omega].");
-
   py::class_<PyMomentumObserver>(m, "MomentumObserver", R"doc(
 Generalized-momentum collision residual (De Luca & Mattone 2005):
 r = K_O (p(t) - p(0) - int (tau + S^T qd - g - F(qd) + r) dt), p = M(q) qd.

@@ -1,5 +1,5 @@
-// Bindings of the uses of the model (SPEC section 8): analytic RNEA derivatives, the Jacobian's
-// time derivative (methods added to the existing Model class) and the momentum observer.
+// Binding of the momentum observer (SPEC section 8; the other uses, rnea_derivatives and
+// jacobian_dot, are Model calls of call_table.hpp).
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -8,7 +8,7 @@ namespace dynid::binding {
 
 namespace py = pybind11;
 
-// After bind_model: adds rnea_derivatives and jacobian_dot to m.Model, and m.MomentumObserver.
+// m.MomentumObserver (after bind_model: its constructor takes a Model).
 void bind_uses(py::module_& m);
 
 }  // namespace dynid::binding

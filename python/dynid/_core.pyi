@@ -80,6 +80,13 @@ class Model:
         Inertia-stack regressor Y_m (n(n+1)/2, 10n [+n]): Y_m @ pi == M[np.tril_indices(n)] (links only, or with the rotor columns the full M) (paper eq. (18)).
         """
     @staticmethod
+    def _jacobian_dot_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
+        """
+        jacobian_dot(self: dynid._core.Model, q: object, qd: object) -> numpy.typing.NDArray[numpy.float64]
+
+        Time derivative (6, n) of jacobian(q) along qd: tool point, world axes, rows [v; omega].
+        """
+    @staticmethod
     def _jacobian_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         jacobian(self: dynid._core.Model, q: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
@@ -115,11 +122,25 @@ class Model:
         Joint-torque regressor Y (n, P) with Y @ parameter_vector(rotor, friction) == rnea; with columns (indices into the P columns, e.g. base_parameters(...).independent) only those, (n, len(columns)); out: a preallocated float64 result array of the exact shape.
         """
     @staticmethod
+    def _rnea_derivatives_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
+        """
+        rnea_derivatives(self: dynid._core.Model, q: object, qd: object, qdd: object) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]
+
+        Analytic partial derivatives (dtau_dq, dtau_dqd) of the joint torques (n, n) each, or (T, n, n) each for T samples (Carpentier & Mansard 2018); dtau_dqd includes diag(Fv), dtau/dqdd is mass_matrix(q). Both are views into one (2, n, n) or (T, 2, n, n) array.
+        """
+    @staticmethod
     def _rnea_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
         """
         rnea(self: dynid._core.Model, q: object, qd: object, qdd: object, out: object = None) -> numpy.typing.NDArray[numpy.float64]
 
         Joint torques tau = M qdd + c + g + Fv qd + Fs sign(qd) (recursive Newton-Euler); with a transmission T the friction is T^T (Fv T qd + Fs sign(T qd)).
+        """
+    @staticmethod
+    def _rnea_time_derivatives_full(*args: typing.Any, **kwargs: typing.Any) -> typing.Any:
+        """
+        rnea_time_derivatives(self: dynid._core.Model, q: object, qd: object, qdd: object, qddd: object, qdddd: object) -> tuple[numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64], numpy.typing.NDArray[numpy.float64]]
+
+        Inverse dynamics and its exact first and second time derivatives (tau, tau_dot, tau_ddot) along a motion with joint derivatives qd, qdd, qddd (jerk) and qdddd (snap): (n,) each, or (T, n) each for T samples (views into one (3, n) or (T, 3, n) array). tau equals rnea(q, qd, qdd) (links, gravity and drive terms); tau_dot = dtau/dq qd + dtau/dqd qdd + M qddd, tau_ddot its time derivative. Drive terms are included (Ia qddd + Fv qdd and Ia qdddd + Fv qddd); Coulomb friction is flat away from qd = 0. Use robot.rigid_body() for the links alone (the link side of ElasticRobot).
         """
     def __init__(
         self,

@@ -2,6 +2,7 @@
 // Every public header is included here; dynid/detail/ holds the internals (not API).
 #pragma once
 
+#include "dynid/batch.hpp"
 #include "dynid/controllers.hpp"
 #include "dynid/coriolis.hpp"
 #include "dynid/coriolis_matrix.hpp"
