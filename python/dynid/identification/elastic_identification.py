@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
+from .. import _core
 from ..model.elastic import ElasticRobot
 from ..model.robot import Robot
 
@@ -96,8 +97,13 @@ def identify_motor_side(
     thetad_, thetadd_, tau_, tau_J_ = _logs(thetad=thetad, thetadd=thetadd, tau=tau, tau_J=tau_J)
     n = thetad_.shape[1]
     out = np.zeros((7, n))
+    # The friction columns from the core's motor friction law (one home: the simulator's and
+    # ElasticRobot's), evaluated with unit coefficients: Fv_m's column thetad, Fs_m's sign(thetad).
+    ones, zeros = np.ones(n), np.zeros(n)
+    viscous = _core._motor_friction(ones, ones, ones, zeros, thetad_, 0.0)
+    coulomb = _core._motor_friction(ones, ones, zeros, ones, thetad_, 0.0)
     for j in range(n):
-        A = np.column_stack([thetadd_[:, j], thetad_[:, j], np.sign(thetad_[:, j])])
+        A = np.column_stack([thetadd_[:, j], viscous[:, j], coulomb[:, j]])
         x, std, out[6, j] = _fit(
             A, tau_[:, j] - tau_J_[:, j], j, "thetad", "motor acceleration, velocity and its sign"
         )
