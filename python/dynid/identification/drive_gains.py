@@ -61,6 +61,7 @@ from ..model.base_parameters import base_parameters
 from ..model.model_files import model_to_dict
 from ..model.robot import Robot
 from ._qr import GroupedTriangularFactors
+from .blocks.offset import Offset
 from .drive_gain_system import (
     current_least_squares,
     payload_vector,
@@ -69,7 +70,6 @@ from .drive_gain_system import (
 )
 from .identify import RankDeficientError, relative_std, solve_factors
 from .log_identification import (
-    OFFSET_NAME,
     STREAM_CHUNK,
     LogIdentification,
     _options,
@@ -205,9 +205,11 @@ def identify_drive_gains(
     last = np.arange(10 * (n - 1), 10 * n)
     if estimated:
         estimated = visible_payload(base.beta[:, last])
-    names = list(base.names) + ([f"{OFFSET_NAME}{j}" for j in range(1, n + 1)] if offset else [])
-    expressions = list(base.expressions)
-    expressions += [f"torque offset of joint {j}" for j in range(1, n + 1)] if offset else []
+    blocks = (Offset(n),) if offset else ()  # the column blocks (dynid.identification.blocks)
+    names, expressions = list(base.names), list(base.expressions)
+    for block in blocks:
+        names += block.names()
+        expressions += block.expressions()
     p = len(names)
     unknowns = names + [f"{GAIN_NAME}{j}" for j in range(1, n + 1)]
     unknowns += [PAYLOAD_NAMES[c] for c in estimated]
@@ -215,7 +217,6 @@ def identify_drive_gains(
         model=model_to_dict(robot),
         rotor=rotor,
         friction=friction,
-        offset=offset,
         method=method,
         parameter_names=list(base.parameter_names),
         independent=base.independent.copy(),
@@ -227,6 +228,7 @@ def identify_drive_gains(
         relative_std=np.zeros(p),
         condition_number=np.nan,
         rank=0,
+        blocks=blocks,
         _robot=robot,
     )
     for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
