@@ -240,8 +240,8 @@ class LogIdentification(ValueEquality):
         """(T, n) the torque of the :meth:`extra_columns` (asymmetric friction, offsets,
         position torque): what the identified model adds to the rigid-body (+ rotor, symmetric
         friction) torque of its base parameters."""
-        extra = self.extra_columns(q, qd)
-        return extra @ self.theta[self.count : self.count + extra.shape[2]]
+        model = self.identification_model
+        return model.extra_columns(q, qd) @ self.theta[model.rigid.size : model.size]
 
     def predict(self, log: Log) -> NDArray[np.float64]:
         """Predicted joint torques (T, n) on ``log`` (qd, qdd computed from q when absent).

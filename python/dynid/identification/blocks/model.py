@@ -47,10 +47,10 @@ class IdentificationModel:
 
     def extra_columns(self, q: object, qd: object) -> NDArray[np.float64]:
         """(T, n, e) the columns of every block, in order: functions of q and qd only."""
-        q = np.asarray(q, dtype=float).reshape(-1, self.n)
-        qd = np.asarray(qd, dtype=float).reshape(q.shape)
-        parts = [np.zeros((q.shape[0], self.n, 0))]
-        parts += [block.columns(q, qd) for block in self.blocks]
+        q_ = np.asarray(q, dtype=float).reshape(-1, self.n)
+        qd_ = np.asarray(qd, dtype=float).reshape(q_.shape)
+        parts = [np.zeros((q_.shape[0], self.n, 0))]
+        parts += [block.columns(q_, qd_) for block in self.blocks]
         return np.concatenate(parts, axis=2)
 
     def regressor(self, q: object, qd: object, qdd: object) -> NDArray[np.float64]:
