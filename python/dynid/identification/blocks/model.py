@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .base import Block
 from .rigid_body import RigidBody
@@ -45,7 +45,7 @@ class IdentificationModel:
     def block(self, key: str) -> Block | None:
         return next((b for b in self.blocks if b.key == key), None)
 
-    def extra_columns(self, q: object, qd: object) -> NDArray[np.float64]:
+    def extra_columns(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """(T, n, e) the columns of every block, in order: functions of q and qd only."""
         q_ = np.asarray(q, dtype=float).reshape(-1, self.n)
         qd_ = np.asarray(qd, dtype=float).reshape(q_.shape)
@@ -53,7 +53,7 @@ class IdentificationModel:
         parts += [block.columns(q_, qd_) for block in self.blocks]
         return np.concatenate(parts, axis=2)
 
-    def regressor(self, q: object, qd: object, qdd: object) -> NDArray[np.float64]:
+    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """(T, n, size) the whole regressor: base columns, then the blocks' columns."""
         return np.concatenate([self.rigid.columns(q, qd, qdd), self.extra_columns(q, qd)], axis=2)
 

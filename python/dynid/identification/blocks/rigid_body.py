@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ...model.robot import Robot
 
@@ -36,14 +36,14 @@ class RigidBody:
         """Number of standard columns P (10 n + the drive terms)."""
         return self.robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
 
-    def columns(self, q: object, qd: object, qdd: object) -> NDArray[np.float64]:
+    def columns(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """(T, n, count) the base columns, selected in C++ (no full (T, n, P) array)."""
         Y = self.robot.regressor(
             q, qd, qdd, rotor=self.rotor, friction=self.friction, columns=self.independent
         )
         return Y[None] if Y.ndim == 2 else Y
 
-    def standard_columns(self, q: object, qd: object, qdd: object) -> NDArray[np.float64]:
+    def standard_columns(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """(T, n, P) all the standard columns (the physically consistent fit's unknowns)."""
         Y = self.robot.regressor(q, qd, qdd, rotor=self.rotor, friction=self.friction)
         return Y[None] if Y.ndim == 2 else Y
