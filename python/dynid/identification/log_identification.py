@@ -51,7 +51,7 @@ from ..model.model_files import load_model, model_from_dict, model_to_dict
 from ..model.robot import Robot
 from .blocks.base import Block, Context
 from .blocks.model import IdentificationModel, kept
-from .blocks.offset import OFFSET_NAME
+from .blocks.offset import OFFSET_NAME as OFFSET_NAME  # its name here before the blocks
 from .blocks.registry import build_blocks, friction_models
 from .blocks.rigid_body import RigidBody
 from .identify import VARIANCE_FLOOR
@@ -60,8 +60,6 @@ from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
 
 PathLike = Union[str, Path]
-
-__all__ = ["OFFSET_NAME", "LogIdentification", "identify_log", "run_validation", "validate_log"]
 
 #: prior_weight of ``identify_log(physical=True, prior=...)`` when none is given: on the LWR4+
 #: logs (docs/real_data.md, "Physically consistent identification") the largest decade at which
