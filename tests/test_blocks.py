@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,11 +22,12 @@ import pytest
 
 import dynid
 from dynid.cli import main
-from dynid.export.result_files import load_result, save_result
+from dynid.export.result_files import load_result, result_to_dict, save_result
 from dynid.identification.blocks import Block, Context, register, unregister
 from dynid.identification.log_identification import identify_log, validate_log
 from dynid.logs import Log, save_log
 from dynid.model.model_files import save_model
+from test_blocks_fixture_log import fixture_log
 from test_log_identification import fourier_log
 
 N = 7
@@ -194,3 +196,39 @@ def test_dynid_identify_computes_the_logs_regressor_once(lwr, tmp_path, monkeypa
     assert main(argv) == 0
     assert calls.count(log.T) == 1
     assert (tmp_path / "out" / "torques.png").is_file()
+
+
+BEFORE = Path(__file__).resolve().parent / "data" / "results_before_blocks"
+FIXTURE_OPTIONS = {
+    "asymmetric": {
+        "rotor": True,
+        "friction": "asymmetric",
+        "offset": True,
+        "position_torque": True,
+    },
+    "symmetric": {"friction": True, "position_torque": True, "method": "ols"},
+}
+
+
+@pytest.mark.parametrize("name", sorted(FIXTURE_OPTIONS))
+def test_results_written_before_the_blocks_load_and_are_reproduced(name):
+    """tests/data/results_before_blocks/*.json were written by dynid 0.2 before the column
+    blocks (tests/test_blocks_fixture_log.py's log, models.planar_2r()): they load, and the
+    same identification today gives the same coefficients, standard deviations and training
+    fit to 1e-12 and the same file content (the dynid version aside)."""
+    robot = dynid.models.planar_2r()
+    before = json.loads((BEFORE / f"{name}.json").read_text())
+    loaded = load_result(BEFORE / f"{name}.json")
+    now = identify_log(fixture_log(robot), robot, **FIXTURE_OPTIONS[name])
+    assert loaded.names == now.names and loaded.blocks == now.blocks
+    np.testing.assert_allclose(now.theta, loaded.theta, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(now.std, loaded.std, rtol=1e-12, atol=1e-15)
+    for key, value in loaded.training["metrics"].items():
+        np.testing.assert_allclose(now.training["metrics"][key], value, rtol=1e-12, atol=1e-15)
+    log = fixture_log(robot)
+    np.testing.assert_allclose(now.predict(log), loaded.predict(log), rtol=0, atol=1e-12)
+    assert now.summary() == loaded.summary()
+    data = json.loads(json.dumps(result_to_dict(now)))
+    for key in ("dynid_version", "coefficients", "covariance", "training", "condition_number"):
+        data.pop(key), before.pop(key)
+    assert data == before
