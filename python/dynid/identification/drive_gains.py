@@ -205,11 +205,12 @@ def identify_drive_gains(
     last = np.arange(10 * (n - 1), 10 * n)
     if estimated:
         estimated = visible_payload(base.beta[:, last])
-    blocks = (Offset(n),) if offset else ()  # the column blocks (dynid.identification.blocks)
+    # The column blocks after the base parameters (dynid.identification.blocks).
+    column_blocks = (Offset(n),) if offset else ()
     names, expressions = list(base.names), list(base.expressions)
-    for block in blocks:
-        names += block.names()
-        expressions += block.expressions()
+    for column_block in column_blocks:
+        names += column_block.names()
+        expressions += column_block.expressions()
     p = len(names)
     unknowns = names + [f"{GAIN_NAME}{j}" for j in range(1, n + 1)]
     unknowns += [PAYLOAD_NAMES[c] for c in estimated]
@@ -228,7 +229,7 @@ def identify_drive_gains(
         relative_std=np.zeros(p),
         condition_number=np.nan,
         rank=0,
-        blocks=blocks,
+        blocks=column_blocks,
         _robot=robot,
     )
     for key in ("params", "Ia", "Fv", "Fs"):  # prior values: no part of the identified model
