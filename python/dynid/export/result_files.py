@@ -11,6 +11,10 @@ the solver's report in ``physical``; ``load_result(...).robot`` is then the iden
 ``options.friction`` says whether the symmetric friction columns Fv, Fs are regressor columns
 (``base_parameters.parameter_names``), ``options.friction_model`` which friction model the
 result has ("none", "symmetric", "asymmetric"; :mod:`dynid.identification.friction_models`).
+The coefficients after the base parameters belong to column blocks
+(:mod:`dynid.identification.blocks`); each block writes and reads its own ``options`` entries
+(``offset``, ``friction_model``, ``position_torque_joints``, ...), and the number of
+coefficients follows from them.
 """
 
 from __future__ import annotations
@@ -24,7 +28,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._version import dynid_version
-from ..identification.friction_models import FRICTION_MODELS, asymmetric_count
+from ..identification.blocks.model import IdentificationModel
+from ..identification.blocks.registry import blocks_from_record, friction_models
+from ..identification.blocks.rigid_body import RigidBody
 from ..identification.log_identification import LogIdentification, LogValidation
 from ..logs.log_files import Log
 from ..model.model_files import dumps_json, load_model, model_from_dict
@@ -75,7 +81,10 @@ def save_result(
     with output_folder(folder, overwrite, inputs=inputs) as staging:
         (staging / RESULT_FILE).write_text(dumps_json(result_to_dict(result)) + "\n")
         if plots and log is not None:
-            save_plots(staging, log, result.predict(log), "training log")
+            # The training log's prediction from the fit (its regressor computed once per run).
+            fitted = result.fitted if log is result.log else None
+            predicted = fitted if fitted is not None else result.predict(log)
+            save_plots(staging, log, predicted, "training log")
     return Path(folder) / RESULT_FILE
 
 
@@ -170,21 +179,24 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     ]
     training = dict(result.training)
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
+    options = {
+        "rotor": result.rotor,
+        "friction": result.friction,
+        "friction_model": result.friction_model,
+        "offset": result.offset,
+        "method": result.method,
+        "exclude_joints": list(result.excluded),
+        "position_torque_joints": [j + 1 for j in result.position_joints],
+    }
+    for block in result.blocks:  # each block's own entries (a new block's new keys)
+        options.update(block.record())
     data = {
         "format": FORMAT,
-        "version": VERSION if result.asymmetric_friction else VERSION_SYMMETRIC,
+        "version": result.identification_model.version(VERSION_SYMMETRIC),
         "dynid_version": dynid_version(),
         "units": UNITS,
         "model": result.model,
-        "options": {
-            "rotor": result.rotor,
-            "friction": result.friction,
-            "friction_model": result.friction_model,
-            "offset": result.offset,
-            "method": result.method,
-            "exclude_joints": list(result.excluded),
-            "position_torque_joints": [j + 1 for j in result.position_joints],
-        },
+        "options": options,
         "condition_number": _num(result.condition_number),
         "rank": result.rank,
         "coefficients": coefficients,
@@ -247,10 +259,12 @@ def result_from_dict(data: Any) -> LogIdentification:
         raise ValueError(
             f"base_parameters.beta: expected shape {(count, len(expected))}, got {beta.shape}"
         )
-    position_joints = _position_joints(options.get("position_torque_joints", []), robot.n)
-    asymmetric = _asymmetric_friction(options.get("friction_model"), flags["friction"])
-    p = count + (robot.n if flags["offset"] else 0) + 2 * len(position_joints)
-    p += asymmetric_count(robot.n, flags["offset"]) if asymmetric else 0
+    _check_friction_model(options.get("friction_model"), flags["friction"])
+    blocks = tuple(blocks_from_record(options, robot.n))
+    model_of_result = IdentificationModel(
+        RigidBody(robot, flags["rotor"], flags["friction"], independent), blocks
+    )
+    p = model_of_result.size
     rows = _get(data, "coefficients")
     if not isinstance(rows, list) or len(rows) != p:
         raise ValueError(f"coefficients: expected a list of {p} entries")
@@ -277,7 +291,6 @@ def result_from_dict(data: Any) -> LogIdentification:
         model=dict(model),
         rotor=flags["rotor"],
         friction=flags["friction"],
-        offset=flags["offset"],
         method=str(method),
         parameter_names=list(names_std),
         independent=independent,
@@ -297,42 +310,24 @@ def result_from_dict(data: Any) -> LogIdentification:
         training=training,
         covariance=_covariance(data.get("covariance"), p),
         physical=physical,
-        position_joints=position_joints,
-        asymmetric_friction=asymmetric,
+        blocks=blocks,
         drive_gains=_drive_gains(data.get("drive_gains"), robot.n),
         _robot=robot,
     )
 
 
-def _asymmetric_friction(model: Any, friction: bool) -> bool:
+def _check_friction_model(model: Any, friction: bool) -> None:
     """options.friction_model (absent before format version 3: from options.friction, which
-    says whether the symmetric Fv, Fs are regressor columns): whether the result has the
-    asymmetric friction columns."""
+    says whether the symmetric Fv, Fs are regressor columns) is a known friction model, the
+    symmetric one exactly when options.friction is true (the friction blocks read it)."""
     if model is None:
-        return False
-    expected = {"none": False, "symmetric": True, "asymmetric": False}
-    if model not in expected or expected[model] != friction:
+        return
+    models = friction_models()
+    if model not in models or (model == "symmetric") != friction:
         raise ValueError(
-            f"options.friction_model: expected {', '.join(map(repr, FRICTION_MODELS))} "
+            f"options.friction_model: expected {', '.join(map(repr, models))} "
             f"matching options.friction = {str(friction).lower()}, got {model!r}"
         )
-    return bool(model == "asymmetric")
-
-
-def _position_joints(value: Any, n: int) -> tuple[int, ...]:
-    """options.position_torque_joints (1-based, increasing; absent in older files: none) as
-    0-based joints."""
-    if not (
-        isinstance(value, list)
-        and all(isinstance(j, int) and not isinstance(j, bool) for j in value)
-        and all(1 <= j <= n for j in value)
-        and value == sorted(set(value))
-    ):
-        raise ValueError(
-            f"options.position_torque_joints: expected increasing joint numbers "
-            f"1..{n}, got {value!r}"
-        )
-    return tuple(j - 1 for j in value)
 
 
 def _drive_gains(value: Any, n: int) -> dict[str, Any] | None:

@@ -62,6 +62,7 @@ from ..model.base_parameters import base_parameters
 from ..model.model_files import model_to_dict
 from ..model.robot import Robot
 from ._qr import GroupedTriangularFactors
+from .blocks.offset import Offset
 from .drive_gain_system import (
     current_least_squares,
     payload_vector,
@@ -71,7 +72,6 @@ from .drive_gain_system import (
 from .gain_consistency import BLOCKS, block_edges, jackknife_std, overconfidence
 from .identify import RankDeficientError, relative_std, solve_factors
 from .log_identification import (
-    OFFSET_NAME,
     STREAM_CHUNK,
     LogIdentification,
     _options,
@@ -207,9 +207,12 @@ def identify_drive_gains(
     last = np.arange(10 * (n - 1), 10 * n)
     if estimated:
         estimated = visible_payload(base.beta[:, last])
-    names = list(base.names) + ([f"{OFFSET_NAME}{j}" for j in range(1, n + 1)] if offset else [])
-    expressions = list(base.expressions)
-    expressions += [f"torque offset of joint {j}" for j in range(1, n + 1)] if offset else []
+    # The column blocks after the base parameters (dynid.identification.blocks).
+    column_blocks = (Offset(n),) if offset else ()
+    names, expressions = list(base.names), list(base.expressions)
+    for column_block in column_blocks:
+        names += column_block.names()
+        expressions += column_block.expressions()
     p = len(names)
     unknowns = names + [f"{GAIN_NAME}{j}" for j in range(1, n + 1)]
     unknowns += [PAYLOAD_NAMES[c] for c in estimated]
@@ -219,7 +222,6 @@ def identify_drive_gains(
         model=model_to_dict(robot, identified=False),
         rotor=rotor,
         friction=friction,
-        offset=offset,
         method=method,
         parameter_names=list(base.parameter_names),
         independent=base.independent.copy(),
@@ -231,6 +233,7 @@ def identify_drive_gains(
         relative_std=np.zeros(p),
         condition_number=np.nan,
         rank=0,
+        blocks=column_blocks,
         _robot=robot,
     )
 

@@ -49,17 +49,17 @@ from ..logs.preparation import prepare_log
 from ..model.base_parameters import base_parameters
 from ..model.model_files import load_model, model_from_dict, model_to_dict
 from ..model.robot import Robot
-from .friction_models import asymmetric_columns, asymmetric_count, asymmetric_names, friction_model
+from .blocks.base import Block, Context
+from .blocks.model import IdentificationModel, kept
+from .blocks.offset import OFFSET_NAME as OFFSET_NAME  # its name here before the blocks
+from .blocks.registry import build_blocks, friction_models
+from .blocks.rigid_body import RigidBody
 from .identify import VARIANCE_FLOOR
 from .physical import physical_least_squares
-from .position_torque import position_columns, position_names, position_torque_joints
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
 
 PathLike = Union[str, Path]
-
-#: Name of the torque-offset coefficient of joint j (1-based): "off1", "off2", ...
-OFFSET_NAME = "off"
 
 #: prior_weight of ``identify_log(physical=True, prior=...)`` when none is given: on the LWR4+
 #: logs (docs/real_data.md, "Physically consistent identification") the largest decade at which
@@ -69,6 +69,11 @@ DEFAULT_PRIOR_WEIGHT = 1e-5
 
 #: Samples per regressor chunk folded into the least-squares factors.
 STREAM_CHUNK = 8192
+
+#: Largest training regressor (bytes) that :func:`identify_log` keeps between the least-squares
+#: pass and the prediction of the training log, so that the log's regressor is computed once;
+#: a longer log's regressor is computed again chunk by chunk (memory bounded by a chunk).
+REGRESSOR_CACHE_BYTES = 1 << 29
 
 #: The options of dynid.prepare_log that ``preparation`` may hold.
 PREPARATION = (
@@ -97,7 +102,13 @@ class LogIdentification(ValueEquality):
     ``friction`` says whether the regressor's symmetric friction columns (Fv, Fs) are among the
     ``parameter_names``; ``asymmetric_friction`` whether the asymmetric ones
     (:mod:`dynid.identification.friction_models`) follow the base parameters instead;
-    ``friction_model`` names the model ("none", "symmetric", "asymmetric").
+    ``friction_model`` names the model ("none", "symmetric", "asymmetric", or a registered
+    friction block's).
+
+    ``blocks`` are the column blocks after the base parameters, in order
+    (:mod:`dynid.identification.blocks`: asymmetric friction, offsets, position torque, ...);
+    ``identification_model`` puts them behind the base columns, each with its slice of
+    ``theta``. ``offset``, ``asymmetric_friction`` and ``position_joints`` are read from them.
 
     A physically consistent result (``identify_log(physical=True)``) has ``physical`` set (the
     solver's report: status, solver, times, prior, prior_weight, margin) and ``model`` holds the
@@ -109,7 +120,6 @@ class LogIdentification(ValueEquality):
     model: dict[str, Any]  #: the robot model (``dynid.model.model_files`` format): DH table etc.
     rotor: bool
     friction: bool
-    offset: bool
     method: str
     parameter_names: list[str]  #: the P standard parameters (regressor columns)
     independent: NDArray[np.int64]  #: base columns among them
@@ -126,17 +136,16 @@ class LogIdentification(ValueEquality):
     covariance: NDArray[np.float64] | None = None
     training: dict[str, Any] = field(default_factory=dict)
     physical: dict[str, Any] | None = None  #: the physically consistent fit's report, if any
-    #: joints (0-based) with a position torque ks_j sin q_j + kc_j cos q_j (``position_torque``)
-    position_joints: tuple[int, ...] = ()
-    #: whether the asymmetric friction columns (Fv+, Fv-, Fs+, Fs-; Fs with offsets) are in
-    #: ``theta`` after the base parameters (then ``friction`` is False)
-    asymmetric_friction: bool = False
+    #: the column blocks after the base parameters (:mod:`dynid.identification.blocks`)
+    blocks: tuple[Block, ...] = ()
     #: identified from motor currents (``dynid.identify_drive_gains``): the drive gains k
     #: ("gains", "gains_std", tau = k * current), the payload that fixed their scale and the
     #: runs; JSON-ready
     drive_gains: dict[str, Any] | None = None
     #: the prepared training log (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
+    #: (T, n) the torques predicted on ``log`` when identified (not saved, not compared)
+    fitted: NDArray[np.float64] | None = field(default=None, repr=False, compare=False)
     _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
@@ -159,19 +168,48 @@ class LogIdentification(ValueEquality):
         return self._robot
 
     @property
+    def identification_model(self) -> IdentificationModel:
+        """The base columns of ``robot``'s regressor, then ``blocks``: each block's columns and
+        its slice of ``theta``."""
+        rigid = RigidBody(self.robot, self.rotor, self.friction, self.independent)
+        return IdentificationModel(rigid, tuple(self.blocks))
+
+    def _block(self, key: str) -> Block | None:
+        return next((b for b in self.blocks if b.key == key), None)
+
+    @property
+    def offset(self) -> bool:
+        """Whether the model has one torque offset per joint (the ``offset`` block)."""
+        return self._block("offset") is not None
+
+    @property
+    def asymmetric_friction(self) -> bool:
+        """Whether the asymmetric friction columns (Fv+, Fv-, Fs+, Fs-; Fs with offsets) are in
+        ``theta`` after the base parameters (then ``friction`` is False)."""
+        return self._block("asymmetric_friction") is not None
+
+    @property
+    def position_joints(self) -> tuple[int, ...]:
+        """Joints (0-based) with a position torque ks_j sin q_j + kc_j cos q_j."""
+        block = self._block("position_torque")
+        return tuple(getattr(block, "joints", ()))
+
+    @property
     def friction_model(self) -> str:
-        """The friction model: "none", "symmetric" or "asymmetric" (:mod:`.friction_models`)."""
-        if self.asymmetric_friction:
-            return "asymmetric"
+        """The friction model: "none", "symmetric", "asymmetric" (:mod:`.friction_models`) or
+        that of a registered friction block."""
+        for block in self.blocks:
+            if block.friction_model is not None:
+                return block.friction_model
         return "symmetric" if self.friction else "none"
 
     @property
     def offsets(self) -> NDArray[np.float64]:
         """(n,) the identified torque offsets (zeros without ``offset``)."""
-        if not self.offset:
+        where = self.identification_model.slice("offset")
+        if where is None:
             return np.zeros(self.n)
-        first = self.count + (asymmetric_count(self.n, True) if self.asymmetric_friction else 0)
-        return np.asarray(self.theta[first : first + self.n], dtype=float)
+        return np.asarray(self.theta[where], dtype=float)
 
     @property
     def position_torque(self) -> bool:
@@ -182,41 +220,26 @@ class LogIdentification(ValueEquality):
         """The (T, n, p) regressor of ``theta``: base columns, then the asymmetric friction
         columns, the offset columns and the position-torque columns (sin q_j, cos q_j of each of
         ``position_joints``), as many as the options ask for."""
-        robot = self.robot
-        total = robot.n * (10 + int(self.rotor) + 2 * int(self.friction))
+        model = self.identification_model
+        total = model.rigid.parameter_count
         if total != len(self.parameter_names):
             raise ValueError(
                 f"model: its regressor has {total} columns, the result expects "
                 f"{len(self.parameter_names)}"
             )
-        # Only the base columns, selected in C++ (no full (T, n, P) array).
-        Y = robot.regressor(
-            q, qd, qdd, rotor=self.rotor, friction=self.friction, columns=self.independent
-        )
-        if Y.ndim == 2:
-            Y = Y[None]
-        return np.concatenate([Y, self.extra_columns(q, qd)], axis=2)
+        return model.regressor(q, qd, qdd)
 
     def extra_columns(self, q: Any, qd: Any) -> NDArray[np.float64]:
         """(T, n, e) the columns of ``theta`` after the base parameters (asymmetric friction,
         offsets, position torque): functions of q and qd only, none of the robot's parameters."""
-        q = np.asarray(q, dtype=float).reshape(-1, self.n)
-        blocks = [np.zeros((q.shape[0], self.n, 0))]
-        if self.asymmetric_friction:
-            qd = np.asarray(qd, dtype=float).reshape(q.shape)
-            blocks.append(asymmetric_columns(qd, self.offset))
-        if self.offset:
-            blocks.append(np.broadcast_to(np.eye(self.n), (q.shape[0], self.n, self.n)))
-        if self.position_joints:
-            blocks.append(position_columns(q, self.position_joints))
-        return np.concatenate(blocks, axis=2)
+        return self.identification_model.extra_columns(q, qd)
 
     def extra_torque(self, q: Any, qd: Any) -> NDArray[np.float64]:
         """(T, n) the torque of the :meth:`extra_columns` (asymmetric friction, offsets,
         position torque): what the identified model adds to the rigid-body (+ rotor, symmetric
         friction) torque of its base parameters."""
-        extra = self.extra_columns(q, qd)
-        return extra @ self.theta[self.count : self.count + extra.shape[2]]
+        model = self.identification_model
+        return model.extra_columns(q, qd) @ self.theta[model.rigid.size : model.size]
 
     def predict(self, log: Log) -> NDArray[np.float64]:
         """Predicted joint torques (T, n) on ``log`` (qd, qdd computed from q when absent).
@@ -230,21 +253,10 @@ class LogIdentification(ValueEquality):
         """Coefficients (value, std, relative std, expression), condition number and rank, and
         the per-joint fit on the training log, as text."""
         options = ", ".join(
-            k.replace("_", " ")
-            for k in ("rotor", "friction", "asymmetric_friction", "offset", "position_torque")
-            if getattr(self, k)
+            [k for k in ("rotor", "friction") if getattr(self, k)]
+            + [block.key.replace("_", " ") for block in self.blocks]
         )
-        offsets = ""
-        if self.asymmetric_friction:
-            offsets += (
-                f" + {asymmetric_count(self.n, self.offset)} asymmetric friction coefficients"
-            )
-        offsets += f" + {self.n} offsets" if self.offset else ""
-        if self.position_joints:
-            offsets += (
-                f" + position torque on joint(s) "
-                f"{', '.join(str(j + 1) for j in self.position_joints)}"
-            )
+        offsets = "".join(f" + {block.describe()}" for block in self.blocks)
         columns = "rigid body" + (f", {options}" if options else "")
         model = (
             f"model: {self.model.get('name') or '?'} ({self.n} joints, "
@@ -343,14 +355,8 @@ def identify_log(
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
         raise ValueError(f"physical: expected True or False, got {physical!r}")
-    kind = friction_model(friction)
-    symmetric, asymmetric = kind == "symmetric", kind == "asymmetric"
-    if asymmetric and robot.coupled:
-        raise ValueError(
-            "friction: the asymmetric model acts on each joint's velocity, but the robot's drives "
-            "are coupled (robot.transmission); friction=True gives the motor-side friction "
-            "T^T (Fv T qd + Fs sign(T qd))"
-        )
+    kind = _friction_model(friction)
+    symmetric = kind == "symmetric"
     if not isinstance(position_torque, (bool, np.bool_)):
         raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
     if not physical and (prior is not None or prior_weight is not None):
@@ -359,36 +365,24 @@ def identify_log(
     if prior_robot is not None and prior_weight is None:
         prior_weight = DEFAULT_PRIOR_WEIGHT
     options = _options(preparation)
+    context = Context(robot, bool(rotor), kind, bool(offset), bool(position_torque))
+    built = build_blocks(context)  # in column order (dynid.identification.blocks.registry)
+    block_notes = [note for block in built for note in block.notes()]
+    blocks = kept(built)
     prepared = _with_derivatives(prepare_log(log, **options), robot.n, robot.name)
     qd, qdd = prepared.qd, prepared.qdd
     assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
     names, expressions = list(base.names), list(base.expressions)
-    if asymmetric:
-        more_names, more_expressions = asymmetric_names(robot.n, bool(offset))
-        names += more_names
-        expressions += more_expressions
-    if offset:
-        names += [f"{OFFSET_NAME}{j}" for j in range(1, robot.n + 1)]
-        expressions += [f"torque offset of joint {j}" for j in range(1, robot.n + 1)]
-    joints: tuple[int, ...] = ()
-    left_out: tuple[int, ...] = ()
-    if position_torque:
-        # The symmetric friction columns stand in for the asymmetric ones: sin q_j, cos q_j
-        # are functions of q_j, independent of any function of qd_j alone either way.
-        joints, left_out = position_torque_joints(
-            robot, bool(rotor), symmetric or asymmetric, bool(offset)
-        )
-        more_names, more_expressions = position_names(joints)
-        names += more_names
-        expressions += more_expressions
+    for block in blocks:
+        names += block.names()
+        expressions += block.expressions()
     result = LogIdentification(
         # Without the parameters and drive terms: their values were a prior, no part of the
         # identified model.
         model=model_to_dict(robot, identified=False),
         rotor=bool(rotor),
         friction=symmetric,
-        offset=bool(offset),
         method=method,
         parameter_names=list(base.parameter_names),
         independent=base.independent.copy(),
@@ -401,17 +395,42 @@ def identify_log(
         condition_number=np.nan,
         rank=0,
         log=prepared,
-        position_joints=joints,
-        asymmetric_friction=asymmetric,
+        blocks=blocks,
         _robot=robot,
     )
-    # The regressor chunk by chunk into the least-squares factors
-    # (dynid.identification.streaming): memory bounded by a chunk whatever the log's length; a
-    # second pass predicts the torques below.
+    model = result.identification_model
+    # The log's regressor is computed once (C++ batch calls). Least squares: chunk by chunk
+    # into the triangular factors (dynid.identification.streaming), the chunks kept for the
+    # prediction below when they fit in REGRESSOR_CACHE_BYTES (otherwise computed again, the
+    # memory bounded by a chunk). Physical: the standard columns of the whole log, which the
+    # SDP needs anyway; the base columns are a selection of them.
     chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
+    standard: NDArray[np.float64] | None = None
+    if physical:
+        standard = np.concatenate(
+            [
+                model.rigid.standard_columns(prepared.q, qd, qdd),
+                model.extra_columns(prepared.q, qd),
+            ],
+            axis=2,
+        )
+        selected = np.concatenate(
+            [base.independent, np.arange(len(base.parameter_names), standard.shape[2])]
+        )
+
+    def chunk_regressor(c: slice) -> NDArray[np.float64]:
+        if standard is not None:
+            return standard[c][..., selected]
+        return model.regressor(prepared.q[c], qd[c], qdd[c])
+
+    cache: dict[int, NDArray[np.float64]] = {}
+    keep = standard is None and prepared.T * robot.n * len(names) * 8 <= REGRESSOR_CACHE_BYTES
     accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
-    for c in chunks:
-        accumulator.add(result.regressor(prepared.q[c], qd[c], qdd[c]), prepared.tau[c])
+    for i, c in enumerate(chunks):
+        Y = chunk_regressor(c)
+        if keep:
+            cache[i] = Y
+        accumulator.add(Y, prepared.tau[c])
     # The physical fit needs the least squares only for the rank, the condition number and the
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
@@ -422,45 +441,43 @@ def identify_log(
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.covariance = fit.covariance
     result.excluded = fit.excluded
-    if physical:
-        _physical(result, prepared, fit.noise_variance, prior_robot, prior_weight or 0.0, prior)
+    if standard is not None:
+        _physical(
+            result, standard, prepared, fit.noise_variance, prior_robot, prior_weight or 0.0, prior
+        )
+    result.fitted = np.concatenate(
+        [
+            (cache[i] if i in cache else chunk_regressor(c)) @ result.theta
+            for i, c in enumerate(chunks)
+        ]
+    )
     result.training = {
         "source": prepared.source,
         "samples": prepared.T,
         "duration_s": prepared.duration,
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
-        "notes": list(prepared.notes) + _position_notes(left_out),
-        "metrics": error_metrics(
-            prepared.tau,
-            np.concatenate(
-                [result.regressor(prepared.q[c], qd[c], qdd[c]) @ result.theta for c in chunks]
-            ),
-        ),
+        "notes": list(prepared.notes) + block_notes,
+        "metrics": error_metrics(prepared.tau, result.fitted),
     }
     return result
 
 
 def _physical(
     result: LogIdentification,
+    Y: NDArray[np.float64],
     log: Log,
     noise_variance: NDArray[np.float64],
     prior: Robot | None,
     prior_weight: float,
     source: Any,
 ) -> None:
-    """Replace the least-squares estimate in ``result`` by the physically consistent one."""
+    """Replace the least-squares estimate in ``result`` by the physically consistent one; ``Y``
+    (T, n, P + e) is the standard regressor of ``log`` followed by the blocks' columns."""
     robot, n = result.robot, result.n
-    assert log.qd is not None and log.qdd is not None  # the prepared log (_with_derivatives)
-    Y = robot.regressor(log.q, log.qd, log.qdd, rotor=result.rotor, friction=result.friction)
-    if Y.ndim == 2:
-        Y = Y[None]
-    columns = result.extra_columns(log.q, log.qd)
-    Y = np.concatenate([Y, columns], axis=2)
-    # Friction dissipates: the asymmetric coefficients are >= 0, as Fv and Fs are.
-    nonnegative = np.zeros(columns.shape[2], dtype=bool)
-    if result.asymmetric_friction:
-        nonnegative[: asymmetric_count(n, result.offset)] = True
+    model = result.identification_model
+    # Each block says which of its coefficients are >= 0 (friction dissipates, as Fv, Fs >= 0).
+    nonnegative = model.nonnegative_extra()
     weights = np.ones(n)
     kept = [j for j in range(n) if j not in result.excluded]
     usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
@@ -477,7 +494,7 @@ def _physical(
         weights=weights,
         prior=prior,
         prior_weight=prior_weight,
-        extra_columns=columns.shape[2],
+        extra_columns=model.extra_size,
         nonnegative_extra=nonnegative,
     )
     result.theta = np.concatenate([fit.base_values, fit.extra])
@@ -502,14 +519,18 @@ def _physical(
     }
 
 
-def _position_notes(left_out: tuple[int, ...]) -> list[str]:
-    if not left_out:
-        return []
-    joints = ", ".join(str(j + 1) for j in left_out)
-    return [
-        f"position torque: not on joint(s) {joints}, where sin q, cos q are combinations of "
-        "the rigid-body columns (gravity) and cannot be told apart from them"
-    ]
+def _friction_model(value: Any) -> str:
+    """``friction`` of :func:`identify_log` as one of the friction models (the built-in ones
+    and the registered friction blocks'): False is "none", True "symmetric". ValueError
+    otherwise."""
+    if isinstance(value, (bool, np.bool_)):
+        return "symmetric" if value else "none"
+    models = friction_models()
+    if isinstance(value, str) and value in models:
+        return value
+    raise ValueError(
+        f"friction: expected True, False or one of {', '.join(map(repr, models))}, got {value!r}"
+    )
 
 
 def _prior_model(prior: Any) -> Robot:

@@ -64,7 +64,7 @@ def robot_from_identification(result: LogIdentification) -> tuple[Robot, Array]:
     robot = result.robot.copy()
     n = robot.n
     pi = np.zeros(len(result.parameter_names))
-    pi[result.independent] = result.theta[: result.count]
+    pi[result.independent] = result.theta[: result.identification_model.rigid.size]
     robot.params = pi[: 10 * n]
     column = 10 * n
     robot.Ia = pi[column : column + n] if result.rotor else np.zeros(n)
