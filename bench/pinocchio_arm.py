@@ -1,7 +1,7 @@
 """The same DH arm as a dynid Robot, built as a Pinocchio model (no URDF).
 
 dynid describes each link by its DH row and ten standard parameters about the origin of DH
-frame i (SPEC section 2). Pinocchio wants, per joint, a revolute-Z (or prismatic-Z) joint whose
+frame i (docs/conventions.md). Pinocchio wants, per joint, a revolute-Z (or prismatic-Z) joint whose
 placement is the constant part of the transform from the parent joint frame, and a body inertia
 in the joint frame. The joint frame J_i is where the joint variable enters:
 

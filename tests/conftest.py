@@ -21,7 +21,8 @@ from reference_model import Arm, params_to_physical
 
 SEED = 20240611
 
-# Table I of the paper (standard DH, [a, alpha, d, theta_offset]), d1 = 0.4, d2 = 0.39 (SPEC §3).
+# Table I of the paper (standard DH, [a, alpha, d, theta_offset]), d1 = 0.4, d2 = 0.39
+# (docs/models.md).
 LWR_DH = np.array(
     [
         [0.0, np.pi / 2, 0.0, 0.0],

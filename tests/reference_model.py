@@ -3,8 +3,8 @@
 Nothing here calls dynid's algorithms. It follows the textbook route rather than the
 recursive one the library uses:
 
-- each DH row gives a homogeneous transform (SPEC §2, written out with explicit
-  Rz, Tz, Tx, Rx matrices);
+- each DH row gives a homogeneous transform (docs/conventions.md, "DH tables", written out with
+  explicit Rz, Tz, Tx, Rx matrices);
 - the geometric Jacobian of a point on link i has the column [z_j x (p - o_j); z_j]
   for a revolute joint j <= i and [z_j; 0] for a prismatic one, z_j being the joint
   axis through o_j (z_{j-1} of the standard frame j-1, z_j of the modified frame j);
@@ -52,7 +52,8 @@ def steiner(mass: float, com: Array, inertia_com: Array) -> Array:
 
 
 def physical_to_params(mass: float, com: Array, inertia_com: Array) -> Array:
-    """[m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] about the frame origin (SPEC §2)."""
+    """[m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] about the frame origin (docs/conventions.md,
+    "Inertial parameters")."""
     i_o = steiner(mass, com, inertia_com)
     h = mass * np.asarray(com, dtype=float)
     return np.array([mass, *h, i_o[0, 0], i_o[0, 1], i_o[0, 2], i_o[1, 1], i_o[1, 2], i_o[2, 2]])

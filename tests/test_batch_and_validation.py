@@ -1,4 +1,5 @@
-"""Batch calls, accepted input forms, and input validation (SPEC §2 "Shapes", "Bad input").
+"""Batch calls, accepted input forms, and input validation (docs/conventions.md "Shapes",
+"Bad input").
 
 - A (T, n) batch gives exactly the per-sample results stacked (1e-14 relative).
 - Lists, integer arrays, float32, Fortran-ordered and strided arrays give the float64 result.
@@ -455,7 +456,7 @@ def test_hypothesis_dynamics_calls(call: str, data: st.DataObject) -> None:
 @given(data=st.data())
 def test_hypothesis_huge_finite_values(call: str, data: st.DataObject) -> None:
     # Finite but enormous inputs (up to 1e300) overflow the arithmetic: the call must then raise
-    # a ValueError naming its inputs, never return inf or NaN (SPEC section 2).
+    # a ValueError naming its inputs, never return inf or NaN (docs/conventions.md, "Bad input").
     names, out_shape = CALLS[call]
     r = robot()
     n = r.n

@@ -71,7 +71,8 @@ def test_identify_validate_and_info(files, tmp_path, capsys):
     assert main(["info", "--model", str(files / "arm.json")]) == 0
     printed = capsys.readouterr().out
     assert "planar 2R: 2 joints (RR), standard DH" in printed
-    assert "base parameters: torque 6 (rigid body)" in printed  # SPEC §3: 6 in a vertical plane
+    # 6 in a vertical plane (docs/base_parameters.md, "Base parameters")
+    assert "base parameters: torque 6 (rigid body)" in printed
 
 
 def test_preparation_options_reach_the_result(files, tmp_path, capsys):

@@ -1,4 +1,4 @@
-"""The C++ package installed with the wheel (SPEC §5, docs/cpp.md), used as a C++ project would.
+"""The C++ package installed with the wheel (docs/cpp.md), used as a C++ project would.
 
 - the installed package holds every public header of cpp/include/dynid, the static core and a
   CMake config (dynidConfig, version, targets) whose paths are all relative to the install prefix
@@ -88,7 +88,8 @@ def test_realtime_example_builds_with_find_package_and_never_allocates(tmp_path,
     assert number(r"max \|Y pi - rnea\| = (\S+) N m") < 1e-9
     assert number(r"max \|forward_dynamics\(rnea\) - qdd\| = (\S+) rad/s\^2") < 1e-9
     assert number(r"prediction error .*: (\S+) relative RMS") < 1e-2
-    # the momentum observer in the loop, no contact: filtered torque noise only (SPEC section 8)
+    # the momentum observer in the loop, no contact: filtered torque noise only (docs/uses.md,
+    # "Collision residual")
     assert number(r"max \|collision residual\| without contact = (\S+) N m") < 0.05
     # Reported, not asserted (a shared machine preempts the process now and then).
     record_property("cycle_us_median", number(r"cycle time \[us\]: median ([0-9.]+)"))

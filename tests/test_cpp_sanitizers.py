@@ -61,8 +61,8 @@ def test_cpp_tests_pass_under_address_and_undefined_sanitizers(
 
 
 def test_dynid_hpp_includes_every_public_header_and_internals_are_in_detail():
-    """SPEC §9: dynid/dynid.hpp includes every public header; the headers under dynid/detail/
-    declare only namespace dynid::detail (compared against the files on disk)."""
+    """docs/cpp.md, "What is API": dynid/dynid.hpp includes every public header; the headers under
+    dynid/detail/ declare only namespace dynid::detail (compared against the files on disk)."""
     include = REPO / "cpp" / "include" / "dynid"
     umbrella = (include / "dynid.hpp").read_text()
     public = sorted(p.name for p in include.glob("*.hpp") if p.name != "dynid.hpp")

@@ -1,4 +1,5 @@
-"""No input or misuse crashes the interpreter (SPEC §2, issue 14 items 3, 4, 5, 7).
+"""No input or misuse crashes the interpreter (docs/conventions.md, "Bad input", issue 14 items 3,
+4, 5, 7).
 
 Each probe runs in a subprocess, so that a segfault or an abort fails the test instead of killing
 pytest; the subprocess exits 0 only when every expected exception was raised with the expected

@@ -36,7 +36,8 @@ METHODS = ("nls", "tls", "wls", "ols")
 
 def pinocchio_torques(robot: dynid.Robot, log: Log) -> np.ndarray:
     """Torques of ``robot`` along ``log`` from Pinocchio (URDF of the robot), plus the drive
-    terms Ia qdd + Fv qd + Fs sign(qd) of SPEC section 2."""
+    terms Ia qdd + Fv qd + Fs sign(qd) of docs/conventions.md,
+    "Drive terms and the torque model"."""
     model = pin.buildModelFromXML(robot.to_urdf())
     model.gravity.linear = robot.gravity_vector
     data = model.createData()

@@ -103,7 +103,7 @@ def test_noise_free_tau_J_equals_the_rigid_robots_rnea(noise_free):
     tau = truth.rigid_body().rnea(q, qd, qdd)
     error = np.abs(ident.rnea(q, qd, qdd) - tau).max()
     assert error <= 1e-9 * np.abs(tau).max(), error
-    # one sample at a time as well (SPEC §2 shapes)
+    # one sample at a time as well (docs/conventions.md, "Shapes")
     np.testing.assert_allclose(
         ident.rnea(q[0], qd[0], qdd[0]), tau[0], rtol=0, atol=1e-9 * np.abs(tau).max()
     )
@@ -326,8 +326,8 @@ def test_same_q7_everywhere_is_reported_with_inertia_coefficient_names():
 
 
 def paper_M76(params7: np.ndarray, q7: np.ndarray) -> np.ndarray:
-    """M_76 of the paper (Sect. VI-2) with I_7 about link 7's origin (SPEC: off-diagonal
-    I_O = I_c - m c c^T): M_76 = -Ixz7 sin q7 - Iyz7 cos q7."""
+    """M_76 of the paper (Sect. VI-2) with I_7 about link 7's origin (docs/conventions.md,
+    "Inertial parameters": off-diagonal I_O = I_c - m c c^T): M_76 = -Ixz7 sin q7 - Iyz7 cos q7."""
     return -params7[6] * np.sin(q7) - params7[8] * np.cos(q7)
 
 

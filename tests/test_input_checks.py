@@ -1,4 +1,5 @@
-"""Bad array input to the Python layer raises ValueError naming the argument (SPEC §2).
+"""Bad array input to the Python layer raises ValueError naming the argument (docs/conventions.md,
+"Bad input").
 
 Every array argument goes through dynid._checks.real_array. NumPy's float cast alone would drop
 the imaginary part of complex numbers (a ComplexWarning at most), turn booleans into 0/1 and

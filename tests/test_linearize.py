@@ -1,4 +1,4 @@
-"""robot.linearize (SPEC §8, notes p. 44-47) against independent computations.
+"""robot.linearize (docs/uses.md, "Linearization", notes p. 44-47) against independent computations.
 
 - Central finite differences of the state function f(x, u) = [qd; forward_dynamics(q, qd, u)]
   at x = (q, qd), u = rnea(q, qd, qdd), so that the linearization is about the trajectory point

@@ -1,4 +1,5 @@
-"""dynid.MomentumObserver (SPEC §8; De Luca & Mattone 2005) and dynid.observer.
+"""dynid.MomentumObserver (docs/uses.md, "Collision residual"; De Luca & Mattone 2005) and
+dynid.observer.
 
 - Simulated contact: the LWR (rotor inertia, viscous friction; Coulomb friction off so that the
   RK4 integration stays fourth order) tracks a sine under PD + gravity compensation, integrated

@@ -1,5 +1,6 @@
-"""jacobian_dot, cartesian_inertia and cartesian_dynamics (SPEC §8; Khatib 1987; notes p. 48-49)
-against independent computations:
+"""jacobian_dot, cartesian_inertia and cartesian_dynamics (docs/uses.md,
+"Cartesian (operational-space) dynamics"; Khatib 1987; notes p. 48-49) against independent
+computations:
 
 - jacobian_dot: central finite differences of jacobian(q) along qd,
   (J(q + h qd) - J(q - h qd)) / 2h, h = 1e-6, 1e-7 relative;

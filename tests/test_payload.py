@@ -184,8 +184,8 @@ def test_with_payload_bad_input_raises_value_error_naming_the_argument(args, nam
     ids=["negative", "triangle", "asymmetric"],
 )
 def test_with_payload_rejects_a_physically_impossible_inertia(inertia):
-    # SPEC §2: a physically impossible body given in physical form raises ValueError (as set_link
-    # does); silently adding it would corrupt the model.
+    # docs/conventions.md, "Bad input": a physically impossible body given in physical form raises
+    # ValueError (as set_link does); silently adding it would corrupt the model.
     with pytest.raises(ValueError, match=r"^inertia\b"):
         dynid.models.kuka_lwr4().with_payload(0.25, (0.0, 0.0, 0.1), inertia)
 

@@ -1,5 +1,5 @@
-"""Physically consistent identification (dynid.physical_least_squares, SPEC 7) against
-independent computations.
+"""Physically consistent identification (dynid.physical_least_squares, docs/identification.md,
+"Physically consistent identification") against independent computations.
 
 The data come from the simulated KUKA LWR-IV of dynid.models (physically consistent links, rotor
 inertias, viscous and Coulomb friction), at random states (q within the limits, |qd| <= 2 rad/s,

@@ -57,7 +57,8 @@ def lwr_blocks(robot, base, count: int, seed: int) -> Array:
 
 def with_payload(robot, mass: float, com: Array):
     """A copy of the robot with a point mass on the last link. Standard parameters of a point
-    mass about the frame origin (SPEC section 2): [m, m r, m (|r|^2 E - r r^T)]."""
+    mass about the frame origin (docs/conventions.md, "Inertial parameters"): [m, m r, m (|r|^2 E -
+    r r^T)]."""
     other = dynid.models.kuka_lwr4()
     params = np.array(robot.params, dtype=float)
     inertia = mass * (com @ com * np.eye(3) - np.outer(com, com))

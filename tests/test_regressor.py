@@ -94,7 +94,8 @@ def test_torque_regressor_reproduces_rnea(case: str, rotor: bool, friction: bool
     Y = robot.regressor(q, qd, qdd, rotor=rotor, friction=friction)
     assert Y.shape == (T_SAMPLES, n, P)
     tau = robot.rnea(q, qd, qdd)
-    # the columns that are off: their terms leave the RNEA torque (SPEC §2's tau), by hand here
+    # the columns that are off: their terms leave the RNEA torque (docs/conventions.md,
+    # "Drive terms and the torque model"'s tau), by hand here
     if not rotor:
         tau = tau - robot.Ia * qdd
     if not friction:
@@ -183,7 +184,8 @@ def test_rnea_difference_is_regressor_times_parameter_difference(case: str) -> N
     n = robot.n
     q, qd, qdd = states(robot)
     rng = np.random.default_rng(SEED + 3)
-    pi_a, pi_b = rng.normal(size=(2, 13 * n))  # any finite values are accepted (SPEC §3)
+    # any finite values are accepted (docs/conventions.md, "Inertial parameters")
+    pi_a, pi_b = rng.normal(size=(2, 13 * n))
     robot_a, robot_b = robot.copy(), robot.copy()
     set_parameters(robot_a, pi_a)
     set_parameters(robot_b, pi_b)

@@ -1,4 +1,5 @@
-"""Analytic RNEA derivatives (SPEC §8, issue 11 item 1) against two independent computations.
+"""Analytic RNEA derivatives (docs/uses.md, "Analytic RNEA derivatives", issue 11 item 1) against
+two independent computations.
 
 - central finite differences of ``robot.rnea`` (step 1e-6: truncation ~1e-12, round-off ~1e-10
   relative), tolerance 1e-7 relative to the largest entry, on every reference arm (both DH

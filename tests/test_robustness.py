@@ -20,8 +20,9 @@ from dynid.identification.log_identification import identify_log
 
 @pytest.mark.parametrize("width", [1e-6, 1e-3, 0.05])
 def test_base_parameters_ignore_joint_limits(width: float) -> None:
-    """SPEC 3: the counts are structural (43/12/39 on the LWR-IV) whatever the limits, and the
-    cached beta reproduces Y pi at configurations far outside those limits (1e-10 relative)."""
+    """docs/base_parameters.md, "Base parameters": the counts are structural (43/12/39 on the
+    LWR-IV) whatever the limits, and the cached beta reproduces Y pi at configurations far outside
+    those limits (1e-10 relative)."""
     robot = dynid.models.kuka_lwr4()
     robot.qlim = np.column_stack([np.full(7, 0.3), np.full(7, 0.3 + width)])
     counts = [dynid.base_parameters(robot, kind).count for kind in ("torque", "gravity", "inertia")]

@@ -1,4 +1,5 @@
-"""Closed-loop simulation (dynid.sim.simulate; SPEC section 8, issue 11 item 4).
+"""Closed-loop simulation (dynid.sim.simulate; docs/uses.md, "Closed-loop simulation", issue 11 item
+4).
 
 Independent references: the total energy T + U from the link velocities and positions
 (kinetic_energy / potential_energy, not from M or g) for conservation; a reference run with a
@@ -302,9 +303,9 @@ def test_encoder_quantises_what_the_controller_sees(lwr):
 
 
 def test_exact_sign_friction_and_prismatic_joints_run(lwr):
-    # coulomb_band = 0 uses sign(qd) (SPEC section 2); a prismatic joint's encoder counts per
-    # metre: a 1-dof horizontal slider of mass 2 kg pushed by 1 N from rest moves t^2 / 4 (RK4
-    # exact for constant acceleration, 1e-12).
+    # coulomb_band = 0 uses sign(qd) (docs/conventions.md, "Drive terms and the torque model"); a
+    # prismatic joint's encoder counts per metre: a 1-dof horizontal slider of mass 2 kg pushed by 1
+    # N from rest moves t^2 / 4 (RK4 exact for constant acceleration, 1e-12).
     slider = dynid.Robot.from_dh([[0.0, 0.0, 0.0, 0.0]], "P", gravity=(0.0, 0.0, 0.0))
     params = np.zeros(10)
     params[0] = 2.0

@@ -134,7 +134,7 @@ def test_path_and_text_give_the_same_robot() -> None:
 
 @pytest.mark.parametrize("convention", CONVENTIONS)
 def test_lwr4_equals_the_hand_derived_tables(convention: str) -> None:
-    # ../shared/data/kuka_lwr4_real/README.md gives the DH tables with frame 0 = lwr_base_link
+    # tests/data/kuka_lwr4_real_README.md gives the DH tables with frame 0 = lwr_base_link
     # (a = theta = 0); tests/data/kuka_lwr4_dh.json the URDF inertials in those frames
     # (derived and checked against Pinocchio independently of dynid; 16 digits stored).
     data = json.loads((Path(__file__).parent / "data" / "kuka_lwr4_dh.json").read_text())

@@ -1,5 +1,5 @@
 """Robot.from_urdf on URDFs it must refuse: a ValueError that names the joint, link or argument
-(SPEC 6), never a silently wrong model; and the defaults for base_link and tip_link."""
+(docs/urdf.md), never a silently wrong model; and the defaults for base_link and tip_link."""
 
 from __future__ import annotations
 

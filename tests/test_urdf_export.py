@@ -1,5 +1,5 @@
 """Robot.to_urdf: the text read back by dynid and by Pinocchio's URDF parser (urdfdom, its own
-algorithms) gives the same model, to 1e-12 relative (SPEC 6); bad links are refused by name;
+algorithms) gives the same model, to 1e-12 relative (docs/urdf.md); bad links are refused by name;
 writing to a path is atomic and never overwrites silently."""
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ namespace bench {
 //   convention standard|modified
 //   gravity gx gy gz                        (world frame)
 //   base r00 r01 r02 r03 ... r33            (16 numbers, row-major: world <- frame 0)
-//   joint R|P a alpha d theta               (one line per link, in order; SPEC DH row)
+//   joint R|P a alpha d theta               (one line per link, in order; docs/conventions.md)
 //   params m mx my mz Ixx Ixy Ixz Iyy Iyz Izz   (one line per link, about DH frame i)
 //   Ia / Fv / Fs  n numbers each            (optional, zeros when absent)
 struct ModelFile {

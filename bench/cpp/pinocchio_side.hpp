@@ -37,8 +37,9 @@ class PinocchioSide {
   const RowMatrixXd& dtau_dq() const;
   const RowMatrixXd& dtau_dqd() const;
 
-  // blockdiag(T_1..T_n), T_i mapping link i's dynid parameters (SPEC order, about DH frame i)
-  // to Pinocchio's (its order, about joint frame i): Y_dynid == Y_pinocchio * regressor_map().
+  // blockdiag(T_1..T_n), T_i mapping link i's dynid parameters (standard order
+  // (docs/conventions.md), about DH frame i) to Pinocchio's (its order, about joint frame i):
+  // Y_dynid == Y_pinocchio * regressor_map().
   Eigen::MatrixXd regressor_map() const;
 
   static std::string version();

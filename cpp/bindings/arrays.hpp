@@ -1,6 +1,6 @@
 // Conversion and validation of NumPy inputs for the binding: every check names the argument,
-// says what was expected and what was given (SPEC section 2), and nothing reaches the core
-// unless it is finite and shaped right.
+// says what was expected and what was given (docs/conventions.md, "Bad input"), and nothing reaches
+// the core unless it is finite and shaped right.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -39,8 +39,8 @@ struct Samples {
 
 Samples parse_samples(std::initializer_list<std::pair<py::handle, const char*>> args, int n);
 
-// Scalars with the type checks of SPEC section 2 (a wrong type is a ValueError naming the
-// argument, not pybind11's TypeError). NumPy scalars and 0-d arrays count as scalars.
+// Scalars with the type checks of docs/conventions.md, "Bad input" (a wrong type is a ValueError
+// naming the argument, not pybind11's TypeError). NumPy scalars and 0-d arrays count as scalars.
 int parse_count(py::handle obj, const char* name);      // an integer >= 1
 double parse_number(py::handle obj, const char* name);  // a real number
 bool parse_flag(py::handle obj, const char* name);      // True or False

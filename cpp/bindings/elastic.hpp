@@ -1,4 +1,4 @@
-// Binding of the elastic-joint simulator (SPEC section 8, last bullet; the exact time derivatives
+// Binding of the elastic-joint simulator (docs/elastic.md; the exact time derivatives
 // of inverse dynamics are the Model call rnea_time_derivatives of call_table.hpp).
 #pragma once
 

@@ -1,4 +1,4 @@
-// Binding of the MomentumObserver of SPEC section 8 (update per sample, run over a log with the
+// Binding of the MomentumObserver of docs/uses.md (update per sample, run over a log with the
 // GIL released); section 8's rnea_derivatives and jacobian_dot are entries of call_table.hpp.
 #include "uses.hpp"
 

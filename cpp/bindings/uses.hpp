@@ -1,4 +1,4 @@
-// Binding of the momentum observer (SPEC section 8; the other uses, rnea_derivatives and
+// Binding of the momentum observer (docs/uses.md; the other uses, rnea_derivatives and
 // jacobian_dot, are Model calls of call_table.hpp).
 #pragma once
 

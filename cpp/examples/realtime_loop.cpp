@@ -2,7 +2,7 @@
 // joint torques of a KUKA LWR-IV by RNEA, builds the joint-torque regressor Y(q, qd, qdd) and
 // feeds the "measured" torques to a recursive least-squares estimate of the dynamic parameters
 // (online identification, notes p. 27: tau = Y pi) and to a generalized-momentum observer whose
-// residual would flag a collision (De Luca; SPEC section 8).
+// residual would flag a collision (De Luca; docs/uses.md, "Collision residual").
 //
 // Real-time rule: everything that needs memory is allocated once, before the loop; inside the
 // loop every call writes into those buffers. The program proves it: it replaces the global
@@ -94,8 +94,9 @@ dynid::Model make_lwr4() {
   return model;
 }
 
-// The parameter vector matching the regressor's columns (SPEC section 2): the 10 standard
-// parameters of each link, link 1 first, then Ia (n), Fv (n), Fs (n).
+// The parameter vector matching the regressor's columns (docs/conventions.md,
+// "Inertial parameters"): the 10 standard parameters of each link, link 1 first, then Ia (n), Fv
+// (n), Fs (n).
 dynid::VectorX parameter_vector(const dynid::Model& model) {
   const int n = model.n();
   dynid::VectorX pi(dynid::regressor_columns(n, true, true));

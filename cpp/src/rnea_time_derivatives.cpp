@@ -19,9 +19,10 @@
 //   f'' = I''' v + 3 I'' a + 3 I' j + I s + I'' a_g.
 // Summed inwards (F_j = sum_{i>=j} f_i) and projected, tau_j = S_j . F_j:
 //   tau'  = S' . F + S . F',   tau'' = S'' . F + 2 S' . F' + S . F''.
-// The drive terms of SPEC section 2 are added last (notes p. 13): Ia qdd + Fv qd + Fs sign(qd)
-// and their derivatives Ia qddd + Fv qdd, Ia qdddd + Fv qddd (Coulomb: flat away from qd = 0);
-// with a transmission T each through T^T (. T ...) (detail/drive_terms.hpp, notes p. 11-13).
+// The drive terms of docs/conventions.md, "Drive terms and the torque model" are added last (notes
+// p. 13): Ia qdd + Fv qd + Fs sign(qd) and their derivatives Ia qddd + Fv qdd, Ia qdddd + Fv qddd
+// (Coulomb: flat away from qd = 0); with a transmission T each through T^T (. T ...)
+// (detail/drive_terms.hpp, notes p. 11-13).
 #include "dynid/rnea_time_derivatives.hpp"
 
 #include "dynid/detail/argument_checks.hpp"

@@ -1,9 +1,9 @@
-// Probe of the C++ size checks (SPEC section 9): every public algorithm, called with each of its
-// arguments the wrong size in turn, throws std::invalid_argument whose message starts with that
-// argument's name (and names the function); called with the right sizes it works, and its result
-// agrees with an independent route (rnea = M qdd + S qd + g + friction, Y pi = rnea, the gravity
-// and inertia regressors against g and M, forward dynamics inverting rnea, 2 T = qd^T M qd,
-// fkine's and the Jacobian's shapes), to 1e-9.
+// Probe of the C++ size checks (docs/cpp.md, "Argument checks"): every public algorithm, called
+// with each of its arguments the wrong size in turn, throws std::invalid_argument whose message
+// starts with that argument's name (and names the function); called with the right sizes it works,
+// and its result agrees with an independent route (rnea = M qdd + S qd + g + friction, Y pi = rnea,
+// the gravity and inertia regressors against g and M, forward dynamics inverting rnea, 2 T = qd^T M
+// qd, fkine's and the Jacobian's shapes), to 1e-9.
 //
 // Built with -fsanitize=address,undefined by tests/cpp/CMakeLists.txt (run by ctest and
 // tests/test_cpp_sanitizers.py): before the checks existed, rnea with a 3-entry qd and a 2-entry

@@ -1,4 +1,4 @@
-// Proof that the uses of SPEC section 8 never touch the heap per call: MomentumObserver::update,
+// Proof that the uses of docs/uses.md never touch the heap per call: MomentumObserver::update,
 // rnea_derivatives and jacobian_dot, 10^4 calls each on a 7-joint arm (standard DH, one
 // prismatic joint, base, tool, drive terms), with every operator new and (on glibc) malloc
 // counted (cpp/examples/allocation_counter.hpp). Also checks that a badly sized argument is a

@@ -1,8 +1,8 @@
 // The description of a serial arm: its name, DH table, gravity, base and tool transforms, joint
-// limits, standard inertial parameters (SPEC section 2) and drive terms. This is the whole robot:
-// the Python Robot keeps no state of its own, and python/dynid/robot_fields.py lists these fields
-// once for copies, pickles, equality, model and result files and `dynid info`. Every per-call
-// buffer lives in a Workspace, so one Model serves many threads.
+// limits, standard inertial parameters (docs/conventions.md) and drive terms. This is the whole
+// robot: the Python Robot keeps no state of its own, and python/dynid/robot_fields.py lists these
+// fields once for copies, pickles, equality, model and result files and `dynid info`. Every
+// per-call buffer lives in a Workspace, so one Model serves many threads.
 //
 // Mutability and threads. A Model is a value: it is built from a DH table and completed with the
 // setters below (set_link, set_parameters, set_rotor_inertia, ...), each of which checks its
@@ -66,7 +66,8 @@ class Model {
   const MatrixX& joint_limits() const { return qlim_; }
   void set_joint_limits(const Eigen::Ref<const MatrixX>& qlim);
 
-  // Standard parameters, n x 10, row i about the origin of DH frame i (SPEC order).
+  // Standard parameters, n x 10, row i about the origin of DH frame i (standard order
+  // (docs/conventions.md)).
   const MatrixX& parameters() const { return parameters_; }
   void set_parameters(const Eigen::Ref<const MatrixX>& parameters);
   void set_link(int i, const RigidBodyParameters& body);

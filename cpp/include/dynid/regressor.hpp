@@ -1,6 +1,6 @@
 // Linear parametrisations of the dynamics in the standard parameters (notes, "Dynamic parameters
-// of robots 4"; paper eqs. (17)-(18)). Columns: the 10n standard parameters in SPEC order, link 1
-// first, then optionally Ia (n), then Fv (n) and Fs (n).
+// of robots 4"; paper eqs. (17)-(18)). Columns: the 10n standard parameters in standard order
+// (docs/conventions.md), link 1 first, then optionally Ia (n), then Fv (n) and Fs (n).
 #pragma once
 
 #include "dynid/model.hpp"

@@ -10,8 +10,9 @@
 
 namespace dynid {
 
-// tau = M(q) qdd + c(q, qd) + g(q) + Fv qd + Fs sign(qd) (the full torque of SPEC section 2,
-// identical to rnea) and its time derivatives along q(t) with derivatives qd, qdd, qddd, qdddd:
+// tau = M(q) qdd + c(q, qd) + g(q) + Fv qd + Fs sign(qd) (the full torque of docs/conventions.md,
+// "Drive terms and the torque model", identical to rnea) and its time derivatives along q(t) with
+// derivatives qd, qdd, qddd, qdddd:
 //   tau_dot  = dtau/dq qd + dtau/dqd qdd + M qddd
 //   tau_ddot = d/dt tau_dot.
 // Drive terms are included: Ia qddd and Fv qdd in tau_dot, Ia qdddd and Fv qddd in tau_ddot;

@@ -28,8 +28,9 @@ struct SimulationSettings {
   Integrator integrator = Integrator::RungeKutta4;
   // Plant friction Fv qd + Fs tanh(qd / coulomb_band) from the model's Fv, Fs. The smoothing
   // band [rad/s or m/s] keeps the right-hand side Lipschitz, so a fixed-step integrator does not
-  // chatter around qd = 0; 0 gives the exact sign(qd) of SPEC section 2. Explicit integration of
-  // the band's slope Fs / band is stable for roughly h < 2.8 M_ii band / Fs_i (RK4).
+  // chatter around qd = 0; 0 gives the exact sign(qd) of docs/conventions.md,
+  // "Drive terms and the torque model". Explicit integration of the band's slope Fs / band is
+  // stable for roughly h < 2.8 M_ii band / Fs_i (RK4).
   bool friction = true;
   double coulomb_band = 1e-3;
   // Standard deviation [N m or N] of white noise added to the commanded torque, one draw per

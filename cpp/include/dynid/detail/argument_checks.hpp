@@ -1,8 +1,8 @@
-// Internal (dynid::detail, not API): the size checks every public algorithm runs first (SPEC
-// section 9), in the manner of Pinocchio's PINOCCHIO_CHECK_ARGUMENT_SIZE. A check is one integer
-// comparison; the message is built only on failure, in a function kept out of line, so the
-// checks cost nothing measurable on the hot path. The message names the argument first, as the
-// Python errors do: "qd: expected 7 entries (one per joint), got 3 (in dynid::rnea)".
+// Internal (dynid::detail, not API): the size checks every public algorithm runs first
+// (docs/cpp.md, "Argument checks"), in the manner of Pinocchio's PINOCCHIO_CHECK_ARGUMENT_SIZE. A
+// check is one integer comparison; the message is built only on failure, in a function kept out of
+// line, so the checks cost nothing measurable on the hot path. The message names the argument
+// first, as the Python errors do: "qd: expected 7 entries (one per joint), got 3 (in dynid::rnea)".
 #pragma once
 
 #include <Eigen/Core>

@@ -1,9 +1,10 @@
-// Internal (dynid::detail, not API): the drive terms of SPEC section 2 (rotor inertia, viscous
-// and Coulomb friction) in one place, for every algorithm that adds them (rnea, crba, forward
-// dynamics, energy, friction, the derivatives, the simulator, the regressors), and the friction
-// law itself (friction_law, coulomb_shape), which the elastic joints' motor equation
-// (detail/elastic_motor.hpp) uses too. The SIMD lane kernels (cpp/src/batch/) keep their own
-// per-lane copy: they may share no inline function with the baseline code (batch_model.hpp).
+// Internal (dynid::detail, not API): the drive terms of docs/conventions.md,
+// "Drive terms and the torque model" (rotor inertia, viscous and Coulomb friction) in one place,
+// for every algorithm that adds them (rnea, crba, forward dynamics, energy, friction, the
+// derivatives, the simulator, the regressors), and the friction law itself (friction_law,
+// coulomb_shape), which the elastic joints' motor equation (detail/elastic_motor.hpp) uses too. The
+// SIMD lane kernels (cpp/src/batch/) keep their own per-lane copy: they may share no inline
+// function with the baseline code (batch_model.hpp).
 //
 // Transmission coupling (notes p. 11-13): the motors turn at theta_dot = T qd (after the gears),
 // so the rotor kinetic energy 1/2 theta_dot^T diag(Ia) theta_dot adds T^T diag(Ia) T to M(q)
@@ -23,8 +24,9 @@ namespace dynid::detail {
 // sign(0) = 0 (notes, "Adding dynamic terms").
 inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
 
-// The Coulomb term's shape s(w): sign(w) for band = 0 (SPEC section 2), else tanh(w / band), the
-// simulators' smoothing of the jump at w = 0 (an explicit integrator chatters on the exact sign).
+// The Coulomb term's shape s(w): sign(w) for band = 0 (docs/conventions.md), else tanh(w / band),
+// the simulators' smoothing of the jump at w = 0 (an explicit integrator chatters on the exact
+// sign).
 inline double coulomb_shape(double w, double band) {
   return band > 0.0 ? std::tanh(w / band) : sign(w);
 }
