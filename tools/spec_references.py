@@ -66,7 +66,7 @@ BASE = "docs/base_parameters.md"
 
 SECTIONS: dict[int, Section] = {
     # 1. Layout
-    1: Section("docs/architecture.md"),
+    1: Section("README.md", "Layout"),
     # 2. Conventions: frames, parameters, torque model, shapes, bad input
     2: Section(
         CONVENTIONS,
@@ -280,7 +280,7 @@ def _quote(text: str, offset: int, path: Path) -> str:
 
 def _link(target: Target, path: Path, text: str, offset: int) -> str:
     """The citation's replacement as written in ``path``: a relative Markdown link in Markdown,
-    ``docs/page.md, "Heading"`` elsewhere."""
+    ``docs/<page>.md, "<heading>"`` elsewhere."""
     if path.suffix != ".md":
         if not target.heading:
             return target.page
