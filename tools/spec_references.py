@@ -66,7 +66,7 @@ BASE = "docs/base_parameters.md"
 
 SECTIONS: dict[int, Section] = {
     # 1. Layout
-    1: Section("README.md", "Layout"),
+    1: Section("docs/architecture.md", "The layers"),
     # 2. Conventions: frames, parameters, torque model, shapes, bad input
     2: Section(
         CONVENTIONS,
