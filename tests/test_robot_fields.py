@@ -73,7 +73,7 @@ VALUES: dict[str, Any] = {
     "Fs": np.array([0.4, 0.5, 0.6]),
     "transmission": np.array([[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [-0.2, 0.3, 1.0]]),
 }
-#: The defaults of a 3-joint RPR arm, written out (SPEC 2; docs/models.md).
+#: The defaults of a 3-joint RPR arm, written out (docs/conventions.md; docs/models.md).
 DEFAULTS: dict[str, Any] = {
     "name": "3-dof arm",
     "gravity": np.array([0.0, 0.0, -9.81]),

@@ -1,5 +1,6 @@
-"""Input checks shared by the Python modules (SPEC §2: bad input raises ``ValueError`` whose
-message starts with the argument's name and says what was expected and what was given).
+"""Input checks shared by the Python modules (docs/conventions.md, "Bad input": bad input raises
+``ValueError`` whose message starts with the argument's name and says what was expected and what was
+given).
 
 One conversion for every array argument, :func:`real_array`: NumPy's own ``float`` cast would
 silently drop the imaginary part of complex numbers (a ComplexWarning at most), turn booleans
@@ -146,7 +147,8 @@ def indices(value: Any, name: str, size: int) -> tuple[int, ...]:
 
 
 def flag(value: Any, name: str) -> bool:
-    """True or False exactly (SPEC 2: ``rotor="no"`` must not read as True)."""
+    """True or False exactly (docs/conventions.md, "Bad input": ``rotor="no"`` must not read as
+    True)."""
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     raise ValueError(f"{name}: expected True or False, got {value!r}")

@@ -81,7 +81,9 @@ def controller_model() -> Robot:
     inertia Ixz and Iyz about its frame origin vanish."""
     robot = models.kuka_lwr4()
     params = robot.params.copy()
-    params[-1, [6, 8]] = 0.0  # Ixz7, Iyz7 (SPEC order m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz)
+    # link 7's Ixz and Iyz: entries 6 and 8 of [m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz]
+    # (docs/conventions.md, "Inertial parameters")
+    params[-1, [6, 8]] = 0.0
     robot.params = params
     return robot
 

@@ -345,7 +345,7 @@ def _check_initial(
     at_rest: bool,
 ) -> FourierTrajectory:
     if not isinstance(initial, FourierTrajectory):
-        # SPEC section 2: a wrong type is a ValueError too
+        # docs/conventions.md, "Bad input": a wrong type is a ValueError too
         raise ValueError(f"initial: expected a FourierTrajectory, got {type(initial).__name__}")
     if (initial.n, initial.harmonics) != (n, harmonics) or not np.isclose(initial.period, period):
         raise ValueError(

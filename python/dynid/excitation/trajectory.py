@@ -282,7 +282,7 @@ def _extents(trajectory: FourierTrajectory, samples: int) -> tuple[NDArray[np.fl
     )
 
 
-# ---- argument checks (SPEC section 2: ValueError naming the argument) ----------------------------
+# ---- argument checks (docs/conventions.md, "Bad input": ValueError naming the argument) ----------
 def _finite_array(value: ArrayLike, name: str) -> NDArray[np.float64]:
     return real_array(value, name).copy()  # a copy: FourierTrajectory freezes its arrays
 

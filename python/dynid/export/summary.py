@@ -1,5 +1,5 @@
 """A robot model as text: what ``dynid info`` prints (DH table, limits, transforms, parameters,
-drive terms and the base-parameter counts of SPEC section 3)."""
+drive terms and the base-parameter counts of docs/base_parameters.md, "Base parameters")."""
 
 from __future__ import annotations
 
@@ -93,7 +93,7 @@ def _transform(robot: Robot, field: RobotField) -> list[str]:
 def _links(robot: Robot, field: RobotField) -> list[str]:
     params = getattr(robot, field.attribute)
     lines = [
-        "parameters (frame-i origin, SPEC order m mx my mz Ixx Ixy Ixz Iyy Iyz Izz); total "
+        "parameters (frame-i origin, standard order m mx my mz Ixx Ixy Ixz Iyy Iyz Izz); total "
         f"mass {params[:, 0].sum():.4g} kg, physically consistent: "
         f"{'yes' if robot.is_physically_consistent() else 'no'}"
     ]

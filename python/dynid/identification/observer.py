@@ -1,5 +1,6 @@
 """Collision residual over a log: the generalized-momentum observer (De Luca & Mattone 2005;
-SPEC §8; the paper's conclusion) run on recorded (q, qd, tau), and its plot.
+docs/uses.md, "Collision residual"; the paper's conclusion) run on recorded (q, qd, tau), and its
+plot.
 
 :class:`dynid.MomentumObserver` (C++) does the work; this module feeds it a :class:`dynid.Log`
 and a model, either a :class:`dynid.Robot` or an identified :class:`dynid.LogIdentification`

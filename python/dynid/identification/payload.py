@@ -47,7 +47,8 @@ from ..model.robot import PARAMETER_FIELDS, Robot
 from .from_controller import IdentifiedModel
 from .identify import LeastSquaresResult, RankDeficientError, least_squares
 
-#: Names of the payload's standard parameters, in the order of the regressor columns (SPEC 2).
+#: Names of the payload's standard parameters, in the order of the regressor columns
+#: (docs/conventions.md, "Inertial parameters").
 PAYLOAD_NAMES = tuple(f"{field}_L" for field in PARAMETER_FIELDS)
 #: A mass estimate is "significant" (centre of mass and inertia about it reported) when above
 #: SIGNIFICANCE standard deviations and above MASS_FLOOR times the arm's total link mass.

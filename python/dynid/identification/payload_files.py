@@ -1,14 +1,14 @@
-"""A known payload from the command line (``dynid identify --current --payload SPEC``).
+"""A known payload from the command line (``dynid identify --current --payload FILE|NUMBERS``).
 
-SPEC is a JSON or YAML file holding either the payload's physical description in the last DH
+FILE is a JSON or YAML file holding either the payload's physical description in the last DH
 frame n::
 
     {"mass": 1.5, "com": [0.0, 0.0, 0.08], "inertia": [[0.004, 0, 0], [0, 0.005, 0], [0, 0, 0.003]]}
 
 (``inertia`` about the centre of mass, frame-n axes; omitted: a point mass), or its 10 standard
 parameters about the origin of frame n (``{"parameters": [m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz,
-Izz]}``), or these 10 numbers written inline, separated by commas. The values are checked by
-:func:`dynid.identify_drive_gains`.
+Izz]}``), or these 10 numbers written inline, separated by commas (NUMBERS). The values are
+checked by :func:`dynid.identify_drive_gains`.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
 """Physically consistent identification: least squares over the standard parameters subject to
-every link being a rigid body that can exist (SPEC section 7).
+every link being a rigid body that can exist (docs/identification.md,
+"Physically consistent identification").
 
 Unconstrained least squares estimates the base parameters; on weakly exciting data the
 estimate, mapped back to any set of standard parameters, can have negative masses, inertias

@@ -1,5 +1,5 @@
-"""Argument checks of :func:`dynid.identification.physical.physical_least_squares` (SPEC 2: a
-ValueError whose
+"""Argument checks of :func:`dynid.identification.physical.physical_least_squares`
+(docs/conventions.md, "Bad input": a ValueError whose
 message starts with the argument's name, says what was expected and what was given)."""
 
 from __future__ import annotations

@@ -93,8 +93,8 @@ def base_parameters(
         raise ValueError("rotor/friction: the gravity regressor has no drive-term columns")
     if kind == "inertia" and friction:
         raise ValueError("friction: the inertia regressor has no friction columns")
-    # Everything the structure depends on (SPEC 3: not the parameter values, nor the limits):
-    # the fields flagged structural in dynid.model.robot_fields.
+    # Everything the structure depends on (docs/base_parameters.md, "Base parameters": not the
+    # parameter values, nor the limits): the fields flagged structural in dynid.model.robot_fields.
     key = (kind, bool(rotor), bool(friction), *robot_fields.structure_key(robot))
     with _CACHE_LOCK:
         cache = robot.__dict__.setdefault("_base_parameter_cache", OrderedDict())
@@ -116,9 +116,9 @@ def stacked_regressor(
 ) -> NDArray[np.float64]:
     """The regressor of ``kind`` on ``samples`` random states, stacked into one (rows, P) matrix.
 
-    The configurations ignore the joint limits (SPEC 3: base parameters are structural): revolute
-    joints cover the full circle and prismatic ones [-1, 1] m, so that tight limits cannot make
-    a generic dependency look structural (or hide one)."""
+    The configurations ignore the joint limits (docs/base_parameters.md, "Base parameters": base
+    parameters are structural): revolute joints cover the full circle and prismatic ones [-1, 1] m,
+    so that tight limits cannot make a generic dependency look structural (or hide one)."""
     rng = np.random.default_rng(seed)
     revolute = np.array([t == "R" for t in robot.joint_types])
     q = rng.uniform(-1.0, 1.0, (samples, robot.n)) * np.where(revolute, np.pi, 1.0)

@@ -7,14 +7,15 @@ A model file is one object (format in ``docs/cli.md``)::
      "gravity": [0, 0, -9.81],
      "rows": [{"a": 0, "alpha": 1.5707963267948966, "d": 0.3105, "theta": 0}, ...]}
 
-``convention`` and ``rows`` are required. Each row is an object ``{a, alpha, d, theta}`` (SPEC §2;
-``theta_offset`` is accepted for ``theta``) or a list ``[a, alpha, d, theta]``; in modified DH the
-names ``a_prev`` and ``alpha_prev`` (a_{i-1}, alpha_{i-1}) may replace ``a`` and ``alpha``, as in
-the LWR4+ tables of ``tests/data/kuka_lwr4_dh.json``. Optional: ``name``, ``joint_types`` (default
-all revolute), ``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4), ``qlim`` (n x 2),
-``params`` (n x 10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each), ``transmission``
-(n x n coupling matrix T, theta_dot = T qd; docs/transmission.md; absent means identity). Unknown
-fields are errors, so that a misspelt ``gravity`` is not silently replaced by the default.
+``convention`` and ``rows`` are required. Each row is an object ``{a, alpha, d, theta}``
+(docs/conventions.md, "DH tables"; ``theta_offset`` is accepted for ``theta``) or a list
+``[a, alpha, d, theta]``; in modified DH the names ``a_prev`` and ``alpha_prev`` (a_{i-1},
+alpha_{i-1}) may replace ``a`` and ``alpha``, as in the LWR4+ tables of
+``tests/data/kuka_lwr4_dh.json``. Optional: ``name``, ``joint_types`` (default all revolute),
+``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4), ``qlim`` (n x 2), ``params`` (n x
+10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each), ``transmission`` (n x n coupling matrix T,
+theta_dot = T qd; docs/transmission.md; absent means identity). Unknown fields are errors, so that a
+misspelt ``gravity`` is not silently replaced by the default.
 
 The fields, their order, which are required and which are left out at their default value come
 from :mod:`dynid.model.robot_fields` (one entry per field of the robot); only the DH rows have a

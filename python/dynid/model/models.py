@@ -2,7 +2,8 @@
 Emika Panda (Gaz et al. 2019) and the Universal Robots UR5 and UR10 (from their URDFs).
 
 Each factory returns a fresh :class:`dynid.Robot` built with ``Robot.from_dh``.
-Units are SI, angles in radians, standard inertial parameters as in SPEC §2.
+Units are SI, angles in radians, standard inertial parameters as in docs/conventions.md,
+"Inertial parameters".
 """
 
 from __future__ import annotations
@@ -77,7 +78,7 @@ _PUMA_DRIVES = np.array([
 def kuka_lwr4() -> Robot:
     """KUKA LWR-IV with plausible, deliberately non-symmetric inertial parameters.
 
-    Kinematics from Table I of Gaz, Flacco, Ferraguti, De Luca, "Identifying the dynamic
+    Kinematics from Table I of Gaz, Flacco, De Luca, "Identifying the dynamic
     model used by the KUKA LWR: a reverse engineering approach", ICRA 2014: standard DH,
     all a_i = 0 and theta offsets 0, alpha = [pi/2, -pi/2, -pi/2, pi/2, pi/2, -pi/2, 0],
     d_3 = d1 = 0.4 m and d_5 = d2 = 0.39 m. As in the paper, frame 0 sits at the shoulder
@@ -231,7 +232,8 @@ def puma560() -> Robot:
     """
     links = _PUMA_LINKS
     dh = np.column_stack([links[:, 0], links[:, 1], links[:, 2], np.zeros(6)])
-    # The core's Steiner transform (SPEC §2), which unlike set_link does not check consistency.
+    # The core's Steiner transform (docs/conventions.md, "Inertial parameters"), which unlike
+    # set_link does not check consistency.
     params = np.array(
         [_core.standard_parameters(row[3], row[4:7], np.diag(row[7:10])) for row in links]
     )

@@ -28,7 +28,7 @@ class Robot(_core.Model):
     Build one with :meth:`Robot.from_dh` or take one from :mod:`dynid.model.models`. The dynamics
     methods (``rnea``, ``mass_matrix``, ``gravity``, ``coriolis``, ``coriolis_matrix``,
     ``friction``, ``forward_dynamics``, ``kinetic_energy``, ``potential_energy``, ``fkine``,
-    ``jacobian``, and SPEC section 8's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
+    ``jacobian``, and docs/uses.md's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
     ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
 
     Every field (``name``, the DH table, gravity, ``base``, ``tool``, ``qlim``, ``params``, the
@@ -109,7 +109,7 @@ class Robot(_core.Model):
         gravity: ArrayLike = (0.0, 0.0, -9.81),
         check_physical: bool = True,
     ) -> Robot:
-        """Build a robot from the serial chain of a URDF (SPEC 6; docs/urdf.md).
+        """Build a robot from the serial chain of a URDF (docs/urdf.md).
 
         ``urdf`` is a path or the XML text. The chain runs from ``base_link`` (default: the root
         link) to ``tip_link`` (default: the single leaf reached through movable joints). Its
@@ -149,7 +149,7 @@ class Robot(_core.Model):
     def to_urdf(
         self, name: str = "robot", path: str | Path | None = None, overwrite: bool = False
     ) -> str:
-        """The robot as URDF text (SPEC 6; docs/urdf.md); with ``path`` also written there
+        """The robot as URDF text (docs/urdf.md); with ``path`` also written there
         (atomically; an existing file only with ``overwrite=True``).
 
         One URDF link per DH link with its inertial about the centre of mass, joints with axis
@@ -291,7 +291,7 @@ class Robot(_core.Model):
         robot_fields.copy_group(robot_fields.defaults(self), other, "drive")
         return other
 
-    # ---- uses of the model (SPEC section 8) ---------------------------------------------------
+    # ---- uses of the model (docs/uses.md) ---------------------------------------------------
     def linearize(
         self, q: ArrayLike, qd: ArrayLike | None = None, qdd: ArrayLike | None = None
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

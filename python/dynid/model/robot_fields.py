@@ -42,7 +42,8 @@ LAYOUTS = ("title", "joint table", "joint columns", "transform", "links", "per j
 #: files and ``dynid info`` leave it out while it has its default value. ``identified``: the
 #: identification estimates it, so a least-squares result's model record leaves it out (its value
 #: in the model was a prior, no part of the identified model). ``structural``: the base-parameter
-#: structure (SPEC 3) depends on it, so it is part of the structure's cache key.
+#: structure (docs/base_parameters.md, "Base parameters") depends on it, so it is part of the
+#: structure's cache key.
 FLAGS = ("required", "omit_default", "identified", "structural")
 
 

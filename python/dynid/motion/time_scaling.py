@@ -9,10 +9,10 @@ gravity, depending on the position only, does not scale (p. 38):
 
     tau_s(kt) = (tau_d(t) - g(q_d(t))) / k^2 + g(q_d(t)).
 
-The notes neglect dissipative terms there. With the drive terms of SPEC section 2
-(tau = (B + diag(Ia)) qdd + c + g + Fv qd + Fs sign(qd)) the rotor inertia is inertial and
-scales with the rest of the 1/k^2 part, viscous friction scales as 1/k and Coulomb friction,
-sign(qd / k) = sign(qd), not at all:
+The notes neglect dissipative terms there. With the drive terms of docs/conventions.md,
+"Drive terms and the torque model" (tau = (B + diag(Ia)) qdd + c + g + Fv qd + Fs sign(qd)) the
+rotor inertia is inertial and scales with the rest of the 1/k^2 part, viscous friction scales as 1/k
+and Coulomb friction, sign(qd / k) = sign(qd), not at all:
 
     tau_s(kt) = (tau_d - g - Fv qd_d - Fs sign(qd_d)) / k^2 + g + Fv qd_d / k + Fs sign(qd_d),
 

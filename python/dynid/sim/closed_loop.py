@@ -7,11 +7,12 @@ with x = (q, qd),
 
 F(qd) = Fv qd + Fs tanh(qd / coulomb_band) the robot's friction (Coulomb smoothed in a small band
 so that a fixed-step integrator does not chatter around qd = 0; ``coulomb_band=0`` is the exact
-sign(qd) of SPEC section 2). A controller runs once per control period dt from the measured
-state and its torque is held over the period (zero-order hold) while the plant is integrated with
-``substeps`` fixed steps h = dt / substeps: classical Runge-Kutta 4 (``method="rk4"``) or
-semi-implicit (symplectic) Euler, qd += h qdd(q, qd), q += h qd (``method="euler"``). The whole
-loop runs in C++ without the GIL; a Python controller takes the GIL for its call only.
+sign(qd) of docs/conventions.md, "Drive terms and the torque model"). A controller runs once per
+control period dt from the measured state and its torque is held over the period (zero-order hold)
+while the plant is integrated with ``substeps`` fixed steps h = dt / substeps: classical Runge-Kutta
+4 (``method="rk4"``) or semi-implicit (symplectic) Euler, qd += h qdd(q, qd), q += h qd
+(``method="euler"``). The whole loop runs in C++ without the GIL; a Python controller takes the GIL
+for its call only.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""URDF in and out (SPEC 6): :meth:`dynid.Robot.from_urdf` and :meth:`dynid.Robot.to_urdf` call
-this package; it does not import :mod:`dynid.model.robot`.
+"""URDF in and out (docs/urdf.md): :meth:`dynid.Robot.from_urdf` and :meth:`dynid.Robot.to_urdf`
+call this package; it does not import :mod:`dynid.model.robot`.
 
 - :mod:`.tree`: the XML read into links and joints, the serial chain between two links;
 - :mod:`.frames`: DH frames along arbitrary joint axes (standard or modified);

@@ -1,4 +1,4 @@
-"""The one rule a robot obeys in URDF, applied by both directions (SPEC 6; docs/urdf.md).
+"""The one rule a robot obeys in URDF, applied by both directions (docs/urdf.md).
 
 - A body: m > 0 and an inertia about its centre of mass that is positive definite and satisfies
   the triangle inequalities (``_core.physical_inconsistency``, the rule of ``set_link`` and

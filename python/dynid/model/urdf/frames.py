@@ -50,7 +50,7 @@ NEARLY_PARALLEL = (1e-10, 1e-3)
 
 
 def dh_standard(a: float, alpha: float, d: float, theta: float) -> Array:
-    """A = Rz(theta) Tz(d) Tx(a) Rx(alpha) (SPEC 2)."""
+    """A = Rz(theta) Tz(d) Tx(a) Rx(alpha) (docs/conventions.md, "DH tables")."""
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
     return np.array(
         [
@@ -63,7 +63,7 @@ def dh_standard(a: float, alpha: float, d: float, theta: float) -> Array:
 
 
 def dh_modified(a: float, alpha: float, d: float, theta: float) -> Array:
-    """A = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i) (SPEC 2)."""
+    """A = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i) (docs/conventions.md, "DH tables")."""
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
     return np.array(
         [

@@ -153,9 +153,10 @@ def _warn_nearly_parallel(joints: list[Joint], axes: Array) -> None:
 
 
 def standard_parameters(mass: float, pose: Array, inertia: Array) -> Array:
-    """[m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] about a frame's origin (SPEC 2) of a body of
-    ``mass`` whose centre-of-mass frame has ``pose`` in that frame and whose inertia about the
-    centre of mass is ``inertia`` in centre-of-mass axes: rotate it (R I R^T), then Steiner."""
+    """[m, mx, my, mz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz] about a frame's origin (docs/conventions.md,
+    "Inertial parameters") of a body of ``mass`` whose centre-of-mass frame has ``pose`` in that
+    frame and whose inertia about the centre of mass is ``inertia`` in centre-of-mass axes: rotate
+    it (R I R^T), then Steiner."""
     rotation, c = pose[:3, :3], pose[:3, 3]
     about_origin = rotation @ inertia @ rotation.T + mass * ((c @ c) * np.eye(3) - np.outer(c, c))
     i = 0.5 * (about_origin + about_origin.T)

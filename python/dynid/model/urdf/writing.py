@@ -1,4 +1,4 @@
-"""A DH robot written as URDF text (SPEC 6), and written to a file atomically.
+"""A DH robot written as URDF text (docs/urdf.md), and written to a file atomically.
 
 Links ``base_link`` (the world, massless), ``link1`` .. ``linkn`` (the DH links) and ``tool``
 (massless, at the tool transform); joints ``joint1`` .. ``jointn`` (revolute or prismatic,
