@@ -5,11 +5,11 @@ a property of ``dynid._core.Model``); the Python class keeps no state of its own
 caches (the base parameters). ``FIELDS`` says for each field what the workflow around the model
 needs to know, and everything that goes over all of the robot's fields is derived from it:
 
-- copies, pickles and equality (:mod:`dynid.robot`, through ``state``, ``restore`` and ``equal``
-  below);
-- model files and the model record of result files (:mod:`dynid.io.model_files`);
-- the cache key of the base-parameter structure (:mod:`dynid.base_parameters`);
-- ``dynid info`` (:mod:`dynid.summary`);
+- copies, pickles and equality (:mod:`dynid.model.robot`, through ``state``, ``restore`` and
+  ``equal`` below);
+- model files and the model record of result files (:mod:`dynid.model.model_files`);
+- the cache key of the base-parameter structure (:mod:`dynid.model.base_parameters`);
+- ``dynid info`` (:mod:`dynid.export.summary`);
 - the drive terms that ``rigid_body`` resets and ``link_frames`` carries over (``group``).
 
 Adding a field to the robot means adding it to the C++ Model (member, setter with its argument
@@ -31,8 +31,8 @@ import numpy as np
 #: decide n and the joint frames); ``label``; ``placement`` (gravity, base and tool transforms);
 #: ``limits``; ``links`` (the standard inertial parameters); ``drive`` (the drive terms).
 GROUPS = ("structure", "label", "placement", "limits", "links", "drive")
-#: How ``dynid info`` shows a field (:mod:`dynid.summary` has one layout per value): ``title``,
-#: the first line; ``joint table``, the DH table itself; ``joint columns``, columns of the DH
+#: How ``dynid info`` shows a field (:mod:`dynid.export.summary` has one layout per value):
+#: ``title``, the first line; ``joint table``, the DH table itself; ``joint columns``, columns of the DH
 #: table (one per ``label`` word); ``transform``, a 4 x 4 matrix on one line; ``links``, the
 #: parameter table; ``per joint``, one line of n numbers; ``matrix``, a titled block of rows.
 LAYOUTS = ("title", "joint table", "joint columns", "transform", "links", "per joint", "matrix")
@@ -55,7 +55,7 @@ class RobotField:
     #: ``attribute`` says otherwise.
     key: str
     #: "text" (a string), "array" (float64 of ``shape``) or "dh" (the DH table, (n, 4): model
-    #: files hold it as rows of named values, :mod:`dynid.io.model_files`).
+    #: files hold it as rows of named values, :mod:`dynid.model.model_files`).
     kind: str
     #: Shape of an array; "n" stands for the number of joints.
     shape: tuple[int | str, ...]
