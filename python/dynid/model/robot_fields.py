@@ -32,9 +32,10 @@ import numpy as np
 #: ``limits``; ``links`` (the standard inertial parameters); ``drive`` (the drive terms).
 GROUPS = ("structure", "label", "placement", "limits", "links", "drive")
 #: How ``dynid info`` shows a field (:mod:`dynid.export.summary` has one layout per value):
-#: ``title``, the first line; ``joint table``, the DH table itself; ``joint columns``, columns of the DH
-#: table (one per ``label`` word); ``transform``, a 4 x 4 matrix on one line; ``links``, the
-#: parameter table; ``per joint``, one line of n numbers; ``matrix``, a titled block of rows.
+#: ``title``, the first line; ``joint table``, the DH table itself; ``joint columns``, columns
+#: of the DH table (one per ``label`` word); ``transform``, a 4 x 4 matrix on one line;
+#: ``links``, the parameter table; ``per joint``, one line of n numbers; ``matrix``, a titled
+#: block of rows.
 LAYOUTS = ("title", "joint table", "joint columns", "transform", "links", "per joint", "matrix")
 
 
