@@ -251,6 +251,7 @@ EXAMPLES = [
         f"// columns in {WORD} order\n",
         "// columns in standard order (docs/conventions.md)\n",
     ),
+    ("tests/a.py", f"# {WORD} §2's tau\n", "# docs/conventions.md's tau\n"),
     (
         "docs/a.md",
         f"the torque of {WORD} §2, with friction\n",

@@ -47,7 +47,8 @@ def test_friction_is_the_law(coupled: bool, band: float) -> None:
 
 @pytest.mark.parametrize("coupled", [False, True])
 def test_zero_band_is_the_robots_friction(coupled: bool) -> None:
-    """Band 0 is SPEC section 2's sign law, Robot.friction, bit for bit."""
+    """Band 0 is the sign law of docs/conventions.md, "Drive terms and the torque model",
+    Robot.friction, bit for bit."""
     robot = drive_robot(coupled)
     qd = np.random.default_rng(5).normal(size=(20, 6))
     qd[0] = 0.0

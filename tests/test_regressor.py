@@ -94,8 +94,8 @@ def test_torque_regressor_reproduces_rnea(case: str, rotor: bool, friction: bool
     Y = robot.regressor(q, qd, qdd, rotor=rotor, friction=friction)
     assert Y.shape == (T_SAMPLES, n, P)
     tau = robot.rnea(q, qd, qdd)
-    # the columns that are off: their terms leave the RNEA torque (docs/conventions.md,
-    # "Drive terms and the torque model"'s tau), by hand here
+    # the columns that are off: their terms leave the RNEA torque (tau of docs/conventions.md,
+    # "Drive terms and the torque model"), by hand here
     if not rotor:
         tau = tau - robot.Ia * qdd
     if not friction:

@@ -254,7 +254,8 @@ def target_of(match: re.Match[str], text: str) -> Target | None:
     if match.group("bullet"):
         return Target("docs/elastic.md", "")
     section = SECTIONS[number]
-    if text[match.end() : match.end() + 2] == ' "':  # quoted headings follow: keep the page
+    if text[match.end() : match.end() + 2] in (' "', "'s"):
+        # quoted headings follow, or a possessive that a quoted heading would make unreadable
         return Target(section.page, "")
     return _narrow(section, contexts)
 

@@ -1,5 +1,5 @@
-// Joint friction (notes, "Adding dynamic terms"; SPEC section 2): the public calls of the law in
-// detail/drive_terms.hpp.
+// Joint friction (notes, "Adding dynamic terms"; docs/conventions.md,
+// "Drive terms and the torque model"): the public calls of the law in detail/drive_terms.hpp.
 #include "dynid/friction.hpp"
 
 #include <cmath>
