@@ -115,8 +115,11 @@ def test_inspect_signature_shows_the_parameters_of_the_cpp_calls() -> None:
     assert list(inspect.signature(dynid.set_threads).parameters) == ["threads"]
     rls = inspect.signature(dynid.RecursiveLeastSquares)
     assert rls.parameters["theta0"].kind is inspect.Parameter.KEYWORD_ONLY
-    # __doc__ keeps pybind11's typed signature line (what pybind11-stubgen and help() read)
-    assert (dynid.Robot.rnea.__doc__ or "").startswith("rnea(self: dynid._core.Model, q: object")
+    # __doc__ keeps a typed signature line (what pybind11-stubgen and help() read); for the
+    # Model's calls it is written from the call table, with the arguments' real types
+    assert (dynid.Robot.rnea.__doc__ or "").startswith(
+        "rnea(self: dynid._core.Model, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike"
+    )
 
 
 def test_every_text_signature_matches_the_pybind11_docstring() -> None:

@@ -6,9 +6,12 @@ Usage (from the repository root, with dynid installed and the ``dev`` extra)::
     python tools/generate_stubs.py            # (re)write python/dynid/_core.pyi
     python tools/generate_stubs.py --check    # exit 1 if the committed stub is out of date
 
-pybind11-stubgen reads the signatures pybind11 writes into the docstrings. The bindings take
-``py::handle`` arguments (they convert and check them in C++ to name the argument in errors), so
-those arrive as ``typing.Any``; the tables below give each such argument its real type by name,
+pybind11-stubgen reads the signatures pybind11 writes into the docstrings. The Model's dynamics
+calls arrive typed: their signature line is written from the call table
+(``cpp/bindings/call_table.hpp``, ``typed_signature`` in ``calls.cpp``), so their stubs follow the
+table. The other bindings take ``py::handle`` arguments (they convert and check them in C++ to
+name the argument in errors), so those arrive as ``typing.Any``; the tables below give each such
+argument its real type by name,
 and every returned ``numpy.ndarray`` becomes ``NDArray[numpy.float64]`` (the core only returns
 float64 arrays). An argument or return value of a new binding that is not in the tables stays
 ``typing.Any`` and is reported: add it to the tables and rerun (``--strict`` makes that an

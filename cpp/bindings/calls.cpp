@@ -226,15 +226,53 @@ std::string text_signature() {
   return text + ")";
 }
 
+// The Python types of the table's arguments and results, for the typed signature line.
+constexpr const char* kArrayLike = "numpy.typing.ArrayLike";
+constexpr const char* kArray = "numpy.typing.NDArray[numpy.float64]";
+
+// The type of an option from its default: a flag (False/True) or an optional array (None).
+std::string option_type(const OptionArg& option) {
+  const std::string literal = option.literal;
+  if (literal == "False" || literal == "True") return "bool";
+  return std::string(kArrayLike) + " | None";
+}
+
+template <class Returns>
+std::string result_type() {
+  if constexpr (kFloat<Returns>) {
+    return std::string("float | ") + kArray;  // a float per sample, an array for T samples
+  } else if constexpr (IsParts<Returns>::value) {
+    std::string parts = "tuple[";
+    for (int k = 0; k < Returns::parts; ++k) parts += (k ? ", " : "") + std::string(kArray);
+    return parts + "]";
+  } else {
+    return kArray;
+  }
+}
+
+// "name(self: dynid._core.Model, q: numpy.typing.ArrayLike, ...) -> numpy.typing.NDArray[...]":
+// the typed signature line of entry K, the one pybind11-stubgen reads (tools/generate_stubs.py),
+// written from the table so that the stub follows it.
+template <std::size_t K>
+std::string typed_signature() {
+  const auto& c = std::get<K>(kCalls);
+  using Returns = typename Entry<K>::returns;
+  std::string text = std::string(c.name) + "(self: dynid._core.Model";
+  for (const char* input : c.inputs) text += std::string(", ") + input + ": " + kArrayLike;
+  for (const OptionArg& option : Entry<K>::options::args)
+    text += std::string(", ") + option.name + ": " + option_type(option) + " = " + option.literal;
+  if (kTakesOut<Returns>) text += std::string(", out: ") + kArray + " | None = None";
+  return text + ") -> " + result_type<Returns>();
+}
+
 template <std::size_t K>
 void bind_call(py::class_<PyModel>& cls) {
   define_method<K>(cls, std::make_index_sequence<kInputs<K>>(),
                    std::make_index_sequence<kOptions<K>>());
-  // pybind11's docstring: its typed signature line (read by pybind11-stubgen), then the text.
-  const py::object method = cls.attr(std::get<K>(kCalls).name);
-  PyObject* function = PyInstanceMethod_GET_FUNCTION(method.ptr());
-  static const std::string doc = text_signature<K>() + "\n--\n\n" +
-                                 reinterpret_cast<PyCFunctionObject*>(function)->m_ml->ml_doc;
+  // The docstring: the text signature, the typed signature line, then the entry's text; all
+  // three from the table (pybind11's own line would type the arguments as `object`).
+  static const std::string doc =
+      text_signature<K>() + "\n--\n\n" + typed_signature<K>() + "\n\n" + std::get<K>(kCalls).doc;
   static PyMethodDef def{std::get<K>(kCalls).name,
                          reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(fast_call<K>)),
                          METH_FASTCALL | METH_KEYWORDS, doc.c_str()};
