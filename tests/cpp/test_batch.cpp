@@ -37,32 +37,6 @@ using Index = Eigen::Index;
 using Strides = Eigen::Stride<Eigen::Dynamic, Eigen::Dynamic>;
 using RowBlock = Eigen::Map<MatrixX, 0, Strides>;
 
-dynid::Model make_arm() {
-  const int n = 7;
-  std::vector<dynid::DHRow> rows(n);
-  for (int i = 0; i < n; ++i) {
-    rows[i].a = 0.05 * i;
-    rows[i].alpha = (i % 2 ? -1.0 : 1.0) * 1.5707963267948966;
-    rows[i].d = 0.1 + 0.02 * i;
-    rows[i].theta = 0.1 * i;
-    rows[i].type = i == 2 ? dynid::JointType::Prismatic : dynid::JointType::Revolute;
-  }
-  dynid::Matrix4 base = dynid::Matrix4::Identity(), tool = dynid::Matrix4::Identity();
-  base(0, 3) = 0.2;
-  tool(2, 3) = 0.1;
-  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base,
-                     tool);
-  for (int i = 0; i < n; ++i) {
-    dynid::Matrix3 inertia = dynid::Matrix3::Identity() * (0.02 + 0.001 * i);
-    model.set_link(i, dynid::RigidBodyParameters::from_physical(
-                          2.0 - 0.2 * i, dynid::Vector3(0.01, -0.02, 0.05), inertia));
-  }
-  model.set_rotor_inertia(VectorX::Constant(n, 0.1));
-  model.set_viscous_friction(VectorX::Constant(n, 0.5));
-  model.set_coulomb_friction(VectorX::Constant(n, 0.3));
-  return model;
-}
-
 RowMajorMatrixX random_samples(Index T, int n, double scale, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-scale, scale);
   RowMajorMatrixX x(T, n);
@@ -328,7 +302,7 @@ bool check_no_allocation(const dynid::Model& model, std::mt19937_64& rng) {
 }  // namespace
 
 int main() {
-  const dynid::Model model = make_arm();
+  const dynid::Model model = make_test_arm();
   std::mt19937_64 rng(20261127);
   if (!allocation_counter_works(model.n())) return 3;
   const std::vector<std::string> paths = dynid::detail::supported_batch_isas();

@@ -20,38 +20,8 @@
 #include "allocation_counter.hpp"  // cpp/examples/
 #include "test_support.hpp"
 
-namespace {
-
-dynid::Model make_arm() {
-  const int n = 7;
-  std::vector<dynid::DHRow> rows(n);
-  for (int i = 0; i < n; ++i) {
-    rows[i].a = 0.05 * i;
-    rows[i].alpha = (i % 2 ? -1.0 : 1.0) * 1.5707963267948966;
-    rows[i].d = 0.1 + 0.02 * i;
-    rows[i].theta = 0.1 * i;
-    rows[i].type = i == 2 ? dynid::JointType::Prismatic : dynid::JointType::Revolute;
-  }
-  dynid::Matrix4 base = dynid::Matrix4::Identity(), tool = dynid::Matrix4::Identity();
-  base(0, 3) = 0.2;
-  tool(2, 3) = 0.1;
-  dynid::Model model(rows, dynid::Convention::Standard, dynid::Vector3(0.0, 0.0, -9.81), base,
-                     tool);
-  for (int i = 0; i < n; ++i) {
-    dynid::Matrix3 inertia = dynid::Matrix3::Identity() * (0.02 + 0.001 * i);
-    model.set_link(i, dynid::RigidBodyParameters::from_physical(
-                          2.0 - 0.2 * i, dynid::Vector3(0.01, -0.02, 0.05), inertia));
-  }
-  model.set_rotor_inertia(dynid::VectorX::Constant(n, 0.1));
-  model.set_viscous_friction(dynid::VectorX::Constant(n, 0.5));
-  model.set_coulomb_friction(dynid::VectorX::Constant(n, 0.3));
-  return model;
-}
-
-}  // namespace
-
 int main() {
-  const dynid::Model model = make_arm();
+  const dynid::Model model = make_test_arm();
   const int n = model.n();
   dynid::Workspace ws(model);
   dynid::VectorX q(n), qd(n), qdd(n), qddd(n), qdddd(n), tau(n), tau_dot(n), tau_ddot(n),
