@@ -21,11 +21,11 @@ import pytest
 import dynid
 from dynid.cli import main
 from dynid.export.result_files import load_result, result_from_dict, result_to_dict, save_result
+from dynid.identification.blocks.registry import friction_model
 from dynid.identification.friction_models import (
     asymmetric_columns,
     asymmetric_count,
     asymmetric_names,
-    friction_model,
 )
 from dynid.identification.log_identification import identify_log, validate_log
 from dynid.identification.observer import residual_from_log, robot_from_identification

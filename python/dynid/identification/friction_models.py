@@ -29,31 +29,13 @@ level >= the backward level, as Fs >= 0 with a free offset does.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
 
 from .. import _core
 
-#: The friction models of :func:`dynid.identify_log` (``friction=``).
-FRICTION_MODELS = ("none", "symmetric", "asymmetric")
-
 #: Suffixes of the asymmetric coefficients' names: "Fv1+" (qd > 0), "Fv1-" (qd < 0).
 POSITIVE, NEGATIVE = "+", "-"
-
-
-def friction_model(value: Any) -> str:
-    """``friction`` of :func:`dynid.identify_log` as one of :data:`FRICTION_MODELS`: False is
-    "none" and True "symmetric" (the meaning they always had). ValueError otherwise."""
-    if isinstance(value, (bool, np.bool_)):
-        return "symmetric" if value else "none"
-    if isinstance(value, str) and value in FRICTION_MODELS:
-        return value
-    raise ValueError(
-        f"friction: expected True, False or one of {', '.join(map(repr, FRICTION_MODELS))}, "
-        f"got {value!r}"
-    )
 
 
 def asymmetric_count(n: int, offset: bool) -> int:

@@ -52,7 +52,7 @@ from ..model.robot import Robot
 from .blocks.base import Block, Context
 from .blocks.model import IdentificationModel, kept
 from .blocks.offset import OFFSET_NAME as OFFSET_NAME  # its name here before the blocks
-from .blocks.registry import build_blocks, friction_models
+from .blocks.registry import build_blocks, friction_model
 from .blocks.rigid_body import RigidBody
 from .identify import VARIANCE_FLOOR
 from .physical import physical_least_squares
@@ -355,7 +355,7 @@ def identify_log(
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
         raise ValueError(f"physical: expected True or False, got {physical!r}")
-    kind = _friction_model(friction)
+    kind = friction_model(friction)
     symmetric = kind == "symmetric"
     if not isinstance(position_torque, (bool, np.bool_)):
         raise ValueError(f"position_torque: expected True or False, got {position_torque!r}")
@@ -517,20 +517,6 @@ def _physical(
         "projected_links": [i + 1 for i in fit.projected],
         "min_pseudo_inertia_eigenvalues": fit.min_eigenvalues.tolist(),
     }
-
-
-def _friction_model(value: Any) -> str:
-    """``friction`` of :func:`identify_log` as one of the friction models (the built-in ones
-    and the registered friction blocks'): False is "none", True "symmetric". ValueError
-    otherwise."""
-    if isinstance(value, (bool, np.bool_)):
-        return "symmetric" if value else "none"
-    models = friction_models()
-    if isinstance(value, str) and value in models:
-        return value
-    raise ValueError(
-        f"friction: expected True, False or one of {', '.join(map(repr, models))}, got {value!r}"
-    )
 
 
 def _prior_model(prior: Any) -> Robot:

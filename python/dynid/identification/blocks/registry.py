@@ -10,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from .base import Block, Context
 from .friction import AsymmetricFriction
 from .offset import Offset
@@ -44,6 +46,19 @@ def friction_models() -> tuple[str, ...]:
     friction models of the registered blocks."""
     more = [b.friction_model for b in REGISTRY.values() if b.friction_model is not None]
     return BUILT_IN_FRICTION + tuple(more)
+
+
+def friction_model(value: Any) -> str:
+    """``friction`` of :func:`dynid.identify_log` as one of :func:`friction_models`: False is
+    "none" and True "symmetric" (the meaning they always had). ValueError otherwise."""
+    if isinstance(value, (bool, np.bool_)):
+        return "symmetric" if value else "none"
+    models = friction_models()
+    if isinstance(value, str) and value in models:
+        return value
+    raise ValueError(
+        f"friction: expected True, False or one of {', '.join(map(repr, models))}, got {value!r}"
+    )
 
 
 def build_blocks(context: Context) -> list[Block]:
