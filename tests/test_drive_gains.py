@@ -389,7 +389,11 @@ def test_cli_identify_current_and_validate(files, tmp_path, capsys, lwr, known):
         (["--payload-mass", "1"], "--payload-log, --payload, --payload-mass: only with --current"),
         (["--method", "tls"], "--method tls: only with --current"),
         (["--current", "--physical"], "--current: not with --physical"),
-        (["--current", "--asymmetric-friction"], "--current: not with --physical"),
+        (["--current", "--prior", "lwr"], "--current: not with --physical or --prior"),
+        (
+            ["--current", "--friction", "--asymmetric-friction"],
+            "--friction, --asymmetric-friction: choose one friction model",
+        ),
         (["--current", "--payload-log", "L", "--payload", "1,2"], "neither a file nor 10"),
     ],
 )

@@ -112,10 +112,10 @@ def identify_from_currents(args: argparse.Namespace) -> None:
     from ..logs.log_files import load_log
     from ..model.model_files import load_model
 
-    if args.physical or args.position_torque or args.prior is not None or args.asymmetric_friction:
-        raise ValueError(
-            "--current: not with --physical, --prior, --position-torque or --asymmetric-friction"
-        )
+    if args.physical or args.prior is not None:
+        raise ValueError("--current: not with --physical or --prior")
+    if args.friction and args.asymmetric_friction:
+        raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     if args.payload_log is None:
         raise ValueError(
             "--current: needs --payload-log LOG, a run with a known payload: currents fix the "
@@ -137,8 +137,9 @@ def identify_from_currents(args: argparse.Namespace) -> None:
         payload=payload,
         payload_mass=args.payload_mass,
         rotor=args.rotor,
-        friction=args.friction,
+        friction="asymmetric" if args.asymmetric_friction else args.friction,
         offset=args.offset,
+        position_torque=args.position_torque,
         method=args.method or "nls",
         preparation=preparation_options(args),
     )

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._version import dynid_version
+from ..identification.blocks.drive_gains import DriveGains
 from ..identification.blocks.model import IdentificationModel
 from ..identification.blocks.registry import blocks_from_record, friction_models
 from ..identification.blocks.rigid_body import RigidBody
@@ -211,8 +212,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     }
     if result.physical is not None:
         data["physical"] = result.physical
-    if result.drive_gains is not None:
-        data["drive_gains"] = result.drive_gains
+    if result.drive_gains is not None:  # the drive-gain block's report (its own entry)
+        data.update(DriveGains(result.n).record(result.drive_gains))
     return data
 
 
@@ -311,7 +312,7 @@ def result_from_dict(data: Any) -> LogIdentification:
         covariance=_covariance(data.get("covariance"), p),
         physical=physical,
         blocks=blocks,
-        drive_gains=_drive_gains(data.get("drive_gains"), robot.n),
+        drive_gains=DriveGains.from_record(data, robot.n),
         _robot=robot,
     )
 
@@ -328,18 +329,6 @@ def _check_friction_model(model: Any, friction: bool) -> None:
             f"options.friction_model: expected {', '.join(map(repr, models))} "
             f"matching options.friction = {str(friction).lower()}, got {model!r}"
         )
-
-
-def _drive_gains(value: Any, n: int) -> dict[str, Any] | None:
-    """drive_gains (results identified from motor currents; absent otherwise): an object whose
-    "gains" are n finite numbers."""
-    if value is None:
-        return None
-    report = _object(value, "drive_gains")
-    gains = _array(_get(report, "gains", "drive_gains"), "drive_gains.gains", 1)
-    if gains.size != n:
-        raise ValueError(f"drive_gains.gains: expected {n} gains, got {gains.size}")
-    return report
 
 
 def _covariance(value: Any, size: int) -> NDArray[np.float64] | None:

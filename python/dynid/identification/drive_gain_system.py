@@ -1,5 +1,7 @@
 """The pieces of :func:`dynid.identify_drive_gains`'s stacked system and its solvers.
 
+- :class:`CurrentModel`: the unknowns (the torque model's coefficients, the drive gains, the
+  payload's estimated parameters), each group's slice by name, and the rows of a run;
 - :func:`payload_vector`: the known part of the payload's standard parameters pi_L and which of
   them are unknowns (with a known mass only);
 - :func:`visible_payload`: the payload parameters the base parameters tell apart;
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -21,7 +24,10 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks as checks
 from .._core import physical_inconsistency, standard_parameters
 from ._qr import GroupedTriangularFactors
+from .blocks.drive_gains import DriveGains
+from .blocks.model import IdentificationModel
 from .identify import VARIANCE_FLOOR, RankDeficientError
+from .payload import PAYLOAD_NAMES
 
 #: "nls": function evaluations per Levenberg-Marquardt run: converged fits need 5-500; beyond,
 #: the fit is running towards an infinite scale (a model that misses a term: gains of 1e9).
@@ -33,6 +39,84 @@ DRIFT_LIMIT = 10.0
 #: "nls": largest relative standard deviation of a gain accepted (beyond, the data do not fix
 #: the scale: a likelihood that is flat along it).
 MAX_RELATIVE_STD = 0.5
+
+
+#: Name of the group of the payload's estimated parameters among the unknowns.
+PAYLOAD = "payload"
+#: Name of the group of the torque model's coefficients (base parameters and column blocks).
+TORQUE = "torque"
+
+
+@dataclass(frozen=True, eq=False)
+class CurrentModel:
+    """The unknowns x of identification from currents, in this order and each group's slice by
+    name (:meth:`slice`): ``"torque"``, the torque model's coefficients (``torque``: the base
+    parameters, then its column blocks); ``"drive_gains"``, the gains k (``gains``, the
+    drive-gain block); ``"payload"``, the payload's parameters that are estimated (``estimated``,
+    indices into the 10 standard parameters; none when the whole payload is known, whose
+    parameters are ``known``). A run's rows (:meth:`rows`; module docstring of
+    :mod:`dynid.identification.drive_gains`):
+
+        unloaded:  [Y | -diag(i) | 0] x = 0
+        loaded:    [Y | -diag(i) | Y_n,estimated] x = -Y_n pi_known
+    """
+
+    torque: IdentificationModel
+    gains: DriveGains
+    known: NDArray[np.float64]
+    estimated: tuple[int, ...]
+
+    @property
+    def n(self) -> int:
+        return self.torque.n
+
+    def sizes(self) -> dict[str, int]:
+        """The groups of unknowns in order, with their sizes."""
+        gains = self.gains
+        return {TORQUE: self.torque.size, gains.key: gains.size, PAYLOAD: len(self.estimated)}
+
+    @property
+    def size(self) -> int:
+        return sum(self.sizes().values())
+
+    def slice(self, key: str) -> slice:
+        """The unknowns of the group ``key`` ("torque", "drive_gains" or "payload")."""
+        start = 0
+        for name, size in self.sizes().items():
+            if name == key:
+                return slice(start, start + size)
+            start += size
+        raise ValueError(f"key: expected one of {', '.join(self.sizes())}, got {key!r}")
+
+    def names(self, torque_names: list[str]) -> list[str]:
+        """The unknowns' names, ``torque_names`` those of the torque model's coefficients."""
+        return [*torque_names, *self.gains.names(), *(PAYLOAD_NAMES[c] for c in self.estimated)]
+
+    def rows(
+        self,
+        q: NDArray[np.float64],
+        qd: NDArray[np.float64],
+        qdd: NDArray[np.float64],
+        current: NDArray[np.float64],
+        loaded: bool,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(A, b): (T, n, size) and (T, n), the rows of T samples of a run."""
+        n = self.n
+        A = np.zeros((q.shape[0], n, self.size))
+        A[:, :, self.slice(TORQUE)] = self.torque.regressor(q, qd, qdd)
+        A[:, :, self.slice(self.gains.key)] = self.gains.columns(current)
+        b = np.zeros((q.shape[0], n))
+        if loaded:
+            # The payload on the last link: the rule of change of the parameters (notes p. 33),
+            # the last link's 10 standard columns.
+            rigid = self.torque.rigid
+            Yn = rigid.robot.regressor(
+                q, qd, qdd, rotor=rigid.rotor, friction=rigid.friction,
+                columns=np.arange(10 * (n - 1), 10 * n),
+            ).reshape(q.shape[0], n, 10)  # fmt: skip
+            A[:, :, self.slice(PAYLOAD)] = Yn[:, :, list(self.estimated)]
+            b = -(Yn @ self.known)
+        return A, b
 
 
 def payload_vector(
@@ -132,7 +216,7 @@ def total_least_squares(
 
 
 def current_least_squares(
-    factors: GroupedTriangularFactors, starts: list[NDArray[np.float64]], p: int
+    factors: GroupedTriangularFactors, starts: list[NDArray[np.float64]], gains: slice
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Weighted nonlinear least squares on the currents, from the first of ``starts`` (the WLS
     and TLS solutions) from which it converges.
@@ -141,7 +225,7 @@ def current_least_squares(
     measured current as the output, so white current noise e_j is the residual and minimising
     sum_j ||A_j x - b_j||^2 / (s_j k_j)^2 is maximum likelihood (s_j the current noise, from the
     residuals, re-estimated twice). Each joint's term is ||R_j [x; -1]||^2 / (s_j k_j)^2 with R_j
-        its triangular factor, so the fit never returns to the samples. A fit counts when
+    its triangular factor, so the fit never returns to the samples. A fit counts when
     Levenberg-Marquardt converges within MAX_EVALUATIONS with the gains within DRIFT_LIMIT of
     the start's; the covariance is the Gauss-Newton (J^T J)^-1. WLS first: biased low but sane,
     the fit converges from it in a few iterations; TLS breaks down at high noise (gains of the
@@ -150,7 +234,7 @@ def current_least_squares(
 
     shift = (factors.b_exp or 0) - (factors.a_exp or 0)
     Rs = list(factors.factors.values())
-    gain = [p + j for j in factors.joints]
+    gain = [gains.start + j for j in factors.joints]  # k_j among the unknowns x
     rows = factors.rows
     size = starts[0].size
     dof = factors.samples * (rows - size) / rows

@@ -62,8 +62,14 @@ from ..model.base_parameters import base_parameters
 from ..model.model_files import model_to_dict
 from ..model.robot import Robot
 from ._qr import GroupedTriangularFactors
-from .blocks.offset import Offset
+from .blocks.base import Context
+from .blocks.drive_gains import DriveGains
+from .blocks.model import kept
+from .blocks.registry import build_blocks, friction_model
 from .drive_gain_system import (
+    PAYLOAD,
+    TORQUE,
+    CurrentModel,
     current_least_squares,
     payload_vector,
     total_least_squares,
@@ -82,8 +88,6 @@ from .payload import PAYLOAD_NAMES
 from .validation import error_metrics
 
 METHODS = ("nls", "tls", "wls", "ols")
-#: Name of the drive gain of joint j (1-based) among the unknowns: "k1", "k2", ...
-GAIN_NAME = "k"
 #: Rank tolerance of the stacked system (that of dynid.least_squares).
 RANK_TOLERANCE = 1e-10
 
@@ -159,8 +163,9 @@ def identify_drive_gains(
     payload: ArrayLike | Mapping[str, Any] | None = None,
     payload_mass: float | None = None,
     rotor: bool = False,
-    friction: bool = False,
+    friction: bool | str = False,
     offset: bool = False,
+    position_torque: bool = False,
     method: str = "nls",
     preparation: Mapping[str, Any] | None = None,
 ) -> DriveGainIdentification:
@@ -175,7 +180,8 @@ def identify_drive_gains(
     parameters in the last DH frame n about the frame's origin, or a mapping with ``mass``,
     ``com`` (3,) in frame n and optional ``inertia`` (3, 3) about the centre of mass) and
     ``payload_mass`` (the mass alone: the payload's other parameters are estimated with the
-    rest). ``rotor``, ``friction`` and ``offset`` are those of :func:`dynid.identify_log`;
+    rest). ``rotor``, ``friction`` (True, False or a friction model's name), ``offset`` and
+    ``position_torque`` are those of :func:`dynid.identify_log`: the same column blocks;
     ``method`` is "nls" (default), "tls", "wls" or "ols" (module docstring). Every joint's rows
     are used (each is the only one that sees its gain).
 
@@ -193,9 +199,12 @@ def identify_drive_gains(
             "robot: its drives are coupled (robot.transmission); drive gains from currents "
             "assume one motor per joint (tau_j = k_j i_j)"
         )
-    rotor, friction, offset = (
-        checks.flag(v, k) for v, k in ((rotor, "rotor"), (friction, "friction"), (offset, "offset"))
+    rotor, offset, position_torque = (
+        checks.flag(v, k)
+        for v, k in ((rotor, "rotor"), (offset, "offset"), (position_torque, "position_torque"))
     )
+    kind = friction_model(friction)
+    symmetric = kind == "symmetric"  # in the rigid-body columns; the others are column blocks
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
     n = robot.n
@@ -203,55 +212,49 @@ def identify_drive_gains(
     runs = [(False, log) for log in _runs(unloaded, "unloaded", n, options)]
     runs += [(True, log) for log in _runs(loaded, "loaded", n, options)]
     known, estimated = payload_vector(payload, payload_mass)
-    base = base_parameters(robot, "torque", rotor=rotor, friction=friction)
-    last = np.arange(10 * (n - 1), 10 * n)
+    base = base_parameters(robot, "torque", rotor=rotor, friction=symmetric)
     if estimated:
-        estimated = visible_payload(base.beta[:, last])
-    # The column blocks after the base parameters (dynid.identification.blocks).
-    column_blocks = (Offset(n),) if offset else ()
+        estimated = visible_payload(base.beta[:, 10 * (n - 1) : 10 * n])
+    # The torque model: the base parameters, then the column blocks these options ask for
+    # (dynid.identification.blocks), as in identify_log.
+    built = build_blocks(Context(robot, rotor, kind, offset, position_torque))
+    column_blocks = kept(built)
     names, expressions = list(base.names), list(base.expressions)
     for column_block in column_blocks:
         names += column_block.names()
         expressions += column_block.expressions()
-    p = len(names)
-    unknowns = names + [f"{GAIN_NAME}{j}" for j in range(1, n + 1)]
-    unknowns += [PAYLOAD_NAMES[c] for c in estimated]
     result = LogIdentification(
         # Without the parameters and drive terms: their values were a prior, no part of the
         # identified model.
         model=model_to_dict(robot, identified=False),
         rotor=rotor,
-        friction=friction,
+        friction=symmetric,
         method=method,
         parameter_names=list(base.parameter_names),
         independent=base.independent.copy(),
         beta=base.beta.copy(),
         names=names,
         expressions=expressions,
-        theta=np.zeros(p),
-        std=np.zeros(p),
-        relative_std=np.zeros(p),
+        theta=np.zeros(len(names)),
+        std=np.zeros(len(names)),
+        relative_std=np.zeros(len(names)),
         condition_number=np.nan,
         rank=0,
         blocks=column_blocks,
         _robot=robot,
     )
+    system = CurrentModel(result.identification_model, DriveGains(n), known, tuple(estimated))
+    unknowns = system.names(names)
+    coefficients, gain, estimates = (
+        system.slice(TORQUE),
+        system.slice(system.gains.key),
+        system.slice(PAYLOAD),
+    )
 
-    def system(log: Log, loaded: bool, c: slice) -> tuple[NDArray, NDArray]:
-        """The rows [Y, -diag(i), Y_n,estimated] and right-hand side of samples c of a run."""
+    def rows(log: Log, loaded: bool, c: slice) -> tuple[NDArray, NDArray]:
+        """The rows of samples c of a run."""
         assert log.qd is not None and log.qdd is not None
-        q, qd, qdd, current = log.q[c], log.qd[c], log.qdd[c], log.tau[c]
-        T = q.shape[0]
-        A = np.zeros((T, n, len(unknowns)))
-        A[:, :, :p] = result.regressor(q, qd, qdd)
-        A[:, np.arange(n), p + np.arange(n)] = -current
-        b = np.zeros((T, n))
-        if loaded:
-            Yn = robot.regressor(q, qd, qdd, rotor=rotor, friction=friction, columns=last)
-            Yn = Yn.reshape(T, n, 10)
-            A[:, :, p + n :] = Yn[:, :, estimated]
-            b = -(Yn @ known)
-        return A, b
+        return system.rows(log.q[c], log.qd[c], log.qdd[c], log.tau[c], loaded)
 
     # Factors per contiguous block of each run (for the jackknife check below), then merged.
     blocks = []
@@ -259,7 +262,7 @@ def identify_drive_gains(
         for lo, hi in block_edges(log.T, max(2, -(-BLOCKS // len(runs)))):
             block = GroupedTriangularFactors(n, len(unknowns), tuple(range(n)))
             for start in range(lo, hi, STREAM_CHUNK):
-                block.add(*system(log, loaded_run, slice(start, min(start + STREAM_CHUNK, hi))))
+                block.add(*rows(log, loaded_run, slice(start, min(start + STREAM_CHUNK, hi))))
             blocks.append(block)
     factors = GroupedTriangularFactors.merged(blocks)
     try:
@@ -280,7 +283,7 @@ def identify_drive_gains(
     if method in ("tls", "nls"):  # the LS fit above checked the rank
         x, covariance = total_least_squares(factors)
         if method == "nls":
-            x, covariance = current_least_squares(factors, [fit.theta, x], p)
+            x, covariance = current_least_squares(factors, [fit.theta, x], gain)
     else:
         x, covariance = fit.theta, fit.covariance
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
@@ -288,49 +291,50 @@ def identify_drive_gains(
     def refit(part: GroupedTriangularFactors) -> NDArray[np.float64]:
         """The gains from part of the rows, by the same method, started from the whole fit."""
         if method == "nls":
-            return current_least_squares(part, [x], p)[0][p : p + n]
+            return current_least_squares(part, [x], gain)[0][gain]
         if method == "tls":
-            return total_least_squares(part)[0][p : p + n]
+            return total_least_squares(part)[0][gain]
         solved = solve_factors(
             part, method=method, names=unknowns, on_rank_deficient="raise",
             rank_tolerance=RANK_TOLERANCE, excluded=(),
         )  # fmt: skip
-        return solved.theta[p : p + n]
+        return solved.theta[gain]
 
     gains_spread = jackknife_std(blocks, refit)
-    warning = overconfidence(
-        unknowns[p : p + n], x[p : p + n], std[p : p + n], gains_spread, method
-    )
+    warning = overconfidence(unknowns[gain], x[gain], std[gain], gains_spread, method)
     if warning is not None:
         warnings.warn(warning, UserWarning, stacklevel=2)
 
     # Per-run residuals and the torque model's fit on the unloaded runs (k i as the measurement).
-    gains = x[p : p + n]
+    gains = x[gain]
     residual = np.zeros((len(runs), n))
     measured, predicted = [], []
     for r, (loaded_run, log) in enumerate(runs):
         squares = np.zeros(n)
         for start in range(0, log.T, STREAM_CHUNK):
-            A, b = system(log, loaded_run, slice(start, start + STREAM_CHUNK))
+            A, b = rows(log, loaded_run, slice(start, start + STREAM_CHUNK))
             squares += np.sum((A @ x - b) ** 2, axis=0)
             if not loaded_run:
-                measured.append(log.tau[start : start + STREAM_CHUNK] * gains)
-                predicted.append(A[:, :, :p] @ x[:p])
+                measured.append(system.gains.torque(log.tau[start : start + STREAM_CHUNK], gains))
+                predicted.append(A[:, :, coefficients] @ x[coefficients])
         residual[r] = np.sqrt(squares / log.T)
     payload_values = known.copy()
     payload_std = np.zeros(10)
     if estimated:
-        payload_values[estimated] = x[p + n :]
-        payload_std[estimated] = std[p + n :]
+        payload_values[estimated] = x[estimates]
+        payload_std[estimated] = std[estimates]
         unseen = [c for c in range(1, 10) if c not in estimated]
         payload_std[unseen] = np.inf  # not separable on this structure: left at 0
-    result.theta, result.std = x[:p].copy(), std[:p].copy()
+    result.theta, result.std = x[coefficients].copy(), std[coefficients].copy()
     result.relative_std = relative_std(result.theta, result.std)
-    result.covariance = covariance[:p, :p].copy()
+    result.covariance = covariance[coefficients, coefficients].copy()
     # The whole system has full rank (solve_factors raised otherwise): theta's part too.
-    result.condition_number, result.rank = fit.condition_number, p
+    result.condition_number, result.rank = fit.condition_number, len(names)
     first = next(log for loaded_run, log in runs if not loaded_run)
-    result.log = replace(first, tau=first.tau * gains, notes=[*first.notes, _converted(gains)])
+    conversion = system.gains.note(gains)
+    result.log = replace(
+        first, tau=system.gains.torque(first.tau, gains), notes=[*first.notes, conversion]
+    )
     sources = [
         {"source": log.source, "loaded": loaded_run, "samples": log.T} for loaded_run, log in runs
     ]
@@ -340,12 +344,12 @@ def identify_drive_gains(
         "duration_s": first.duration,
         "sampling_rate_hz": first.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
-        "notes": [*first.notes, _converted(gains)],
+        "notes": [*first.notes, *(note for b in built for note in b.notes()), conversion],
         "metrics": error_metrics(np.concatenate(measured), np.concatenate(predicted)),
     }
     result.drive_gains = {
         "gains": gains.tolist(),
-        "gains_std": std[p : p + n].tolist(),
+        "gains_std": std[gain].tolist(),
         # the block jackknife's (gain_consistency): None when leaving a block out fixes nothing
         "gains_std_blocks": None if gains_spread is None else gains_spread.tolist(),
         "method": method,
@@ -356,7 +360,7 @@ def identify_drive_gains(
     }
     return DriveGainIdentification(
         gains=gains.copy(),
-        gains_std=std[p : p + n].copy(),
+        gains_std=std[gain].copy(),
         result=result,
         payload=payload_values,
         payload_std=payload_std,
@@ -383,7 +387,8 @@ def torques_from_currents(result: LogIdentification, log: Log) -> Log:
     gains = np.asarray(report["gains"], dtype=float)
     if log.n != gains.size:
         raise ValueError(f"log: has {log.n} joints, the result's gains {gains.size}")
-    return replace(log, tau=log.tau * gains, notes=[*log.notes, _converted(gains)])
+    block = DriveGains(log.n)
+    return replace(log, tau=block.torque(log.tau, gains), notes=[*log.notes, block.note(gains)])
 
 
 # --------------------------------------------------------------------------- helpers
@@ -437,12 +442,6 @@ def _runs(value: Any, name: str, n: int, options: Mapping[str, Any]) -> list[Log
 
 def _arrays(value: tuple) -> bool:
     return all(np.ndim(a) == 2 for a in value)
-
-
-def _converted(gains: NDArray[np.float64]) -> str:
-    return "tau = k * current with the identified drive gains k = " + ", ".join(
-        f"{k:.6g}" for k in gains
-    )
 
 
 def _finite(value: float) -> float | None:

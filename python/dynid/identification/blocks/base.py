@@ -96,3 +96,51 @@ class Block(ABC):
     def describe(self) -> str:
         """The block in the summary's list of coefficients, e.g. "7 offsets"."""
         return f"{self.size} {self.key.replace('_', ' ')} coefficients"
+
+
+class MeasurementBlock(ABC):
+    """A group of columns that come from the measurement, not from the state: the log holds a
+    signal s (e.g. motor currents) whose torque is ``torque(s, coefficients)``, linear in the
+    coefficients, so that the torque model Y theta = tau reads Y theta - C(s) c = 0 with C(s)
+    the block's ``columns``. Its coefficients are no part of the torque model's theta (the
+    model predicts torques, the block converts the measurement); the result keeps them in a
+    report of the block's own (``record``). Subclasses are frozen dataclasses."""
+
+    #: Name of the block: its group of unknowns, and its entry of result.json.
+    key: ClassVar[str]
+
+    n: int  #: number of joints
+
+    @abstractmethod
+    def names(self) -> list[str]:
+        """The names of the block's coefficients, in column order."""
+
+    @abstractmethod
+    def expressions(self) -> list[str]:
+        """What each coefficient is, in words."""
+
+    @abstractmethod
+    def columns(self, measured: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(T, n, size) the columns C(s) of the measured signal s (T, n), with the sign they
+        have on the model's side: Y theta + C(s) c = 0."""
+
+    @abstractmethod
+    def torque(
+        self, measured: NDArray[np.float64], coefficients: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """(T, n) the torque of the measured signal (T, n) with these coefficients (size,)."""
+
+    @abstractmethod
+    def record(self, report: Mapping[str, Any]) -> dict[str, Any]:
+        """The entries of result.json that hold the block's ``report`` (JSON-ready)."""
+
+    @classmethod
+    @abstractmethod
+    def from_record(cls, data: Mapping[str, Any], n: int) -> dict[str, Any] | None:
+        """The block's report as :meth:`record` wrote it in result.json's ``data`` (None when
+        the file has none). ValueError naming the entry when malformed."""
+
+    @property
+    def size(self) -> int:
+        """Number of coefficients."""
+        return len(self.names())
