@@ -203,8 +203,10 @@ def validate(args: argparse.Namespace) -> None:
 def export(args: argparse.Namespace) -> None:
     from ..export.result_files import export_robot
 
-    path = export_robot(args.source, args.urdf, name=args.name, overwrite=args.overwrite)
-    print(f"wrote {path}", flush=True)
+    written = export_robot(
+        args.source, args.urdf, mjcf=args.mjcf, name=args.name, overwrite=args.overwrite
+    )
+    print(f"wrote {', '.join(map(str, written))}", flush=True)
 
 
 def residual(args: argparse.Namespace) -> None:

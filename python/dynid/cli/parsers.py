@@ -141,15 +141,22 @@ def _add_info(subcommands: Any) -> None:
 def _add_export(subcommands: Any) -> None:
     p = subcommands.add_parser(
         "export",
-        help="write a model or a physically consistent result as URDF",
-        description="Write the robot of SOURCE as a URDF: SOURCE is a result folder (or its "
-        "result.json) of `dynid identify --physical`, a built-in model name, a model file or a "
-        "URDF. Least-squares results hold base parameters only and cannot be exported.",
+        help="write a model or a physically consistent result as URDF and/or MuJoCo MJCF",
+        description="Write the robot of SOURCE as a URDF and/or a MuJoCo MJCF file: SOURCE is a "
+        "result folder (or its result.json) of `dynid identify --physical`, a built-in model "
+        "name, a model file or a URDF. Least-squares results hold base parameters only and "
+        "cannot be exported.",
     )
     p.add_argument("source", metavar="SOURCE", help="result folder/result.json, model or URDF")
-    p.add_argument("--urdf", required=True, metavar="FILE", help="the URDF file to write")
+    p.add_argument("--urdf", metavar="FILE", help="the URDF file to write")
+    p.add_argument(
+        "--mjcf",
+        metavar="FILE",
+        help="the MuJoCo MJCF file to write (armature = Ia, damping = Fv, frictionloss = Fs; "
+        "docs/export.md)",
+    )
     p.add_argument("--name", help="robot name in the URDF (default: the model's name)")
-    p.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
+    p.add_argument("--overwrite", action="store_true", help="replace the files if they exist")
     p.set_defaults(run=commands.export)
 
 

@@ -411,12 +411,23 @@ def load_model_or_result(source: PathLike) -> Robot | LogIdentification:
 
 
 def export_robot(
-    source: PathLike, urdf: PathLike, *, name: str | None = None, overwrite: bool = False
-) -> Path:
-    """Write the robot of ``source`` as a URDF file (``dynid export``): ``source`` is a result
-    folder or ``result.json`` of a physically consistent identification, or anything
-    :func:`~dynid.model.model_files.load_model` reads (a built-in name, a model file, a URDF).
-    A least-squares result holds base parameters only, not a robot: a ValueError says so."""
+    source: PathLike,
+    urdf: PathLike | None = None,
+    *,
+    mjcf: PathLike | None = None,
+    name: str | None = None,
+    overwrite: bool = False,
+) -> list[Path]:
+    """Write the robot of ``source`` as URDF (``urdf``) and/or MuJoCo MJCF (``mjcf``; at least
+    one) for ``dynid export``: ``source`` is a result folder or ``result.json`` of a physically
+    consistent identification, or anything :func:`~dynid.model.model_files.load_model` reads (a
+    built-in name, a model file, a URDF). A least-squares result holds base parameters only, not
+    a robot: a ValueError says so. Returns the files written. Both files are checked before
+    either is written (an existing file without ``overwrite``, a robot the format refuses)."""
+    from .mjcf import mjcf_text, write_mjcf
+
+    if urdf is None and mjcf is None:
+        raise ValueError("urdf, mjcf: give at least one file to write (--urdf FILE, --mjcf FILE)")
     loaded = load_model_or_result(source)
     if isinstance(loaded, LogIdentification):
         result = loaded
@@ -428,5 +439,19 @@ def export_robot(
         robot = result.robot
     else:
         robot = loaded
-    robot.to_urdf(name=name or robot.name, path=urdf, overwrite=overwrite)
-    return Path(urdf)
+    name = name or robot.name
+    targets = [Path(p) for p in (urdf, mjcf) if p is not None]
+    for target in targets:
+        if target.exists() and not overwrite:
+            raise ValueError(
+                f"path: {target} exists; pass overwrite=True (--overwrite) to replace it"
+            )
+    if mjcf is not None:
+        mjcf_text(robot, name)  # refused before anything is written
+    written = []
+    if urdf is not None:
+        robot.to_urdf(name=name, path=urdf, overwrite=overwrite)
+        written.append(Path(urdf))
+    if mjcf is not None:
+        written.append(write_mjcf(robot, mjcf, name=name, overwrite=overwrite))
+    return written

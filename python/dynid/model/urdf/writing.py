@@ -5,16 +5,10 @@ Links ``base_link`` (the world, massless), ``link1`` .. ``linkn`` (the DH links)
 axis z) and the fixed ``tool_joint``.
 
 URDF moves a joint's child about (along) an axis through the child's origin, so URDF link i's
-frame is *joint i's frame*: z on joint i's axis, at q_i:
-
-- standard DH: frame i-1 turned by q_i (Rz(q_i), or Tz(q_i) if prismatic); DH frame i sits at
-  K_i = A_i(q=0) = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i) in it;
-- modified DH: DH frame i without its own offsets, frame i-1 times Rx(alpha_{i-1}) Tx(a_{i-1})
-  Rz(q_i); DH frame i sits at K_i = Rz(theta_i) Tz(d_i) in it (K_i = identity without offsets).
-
-Every constant rotation between consecutive frames is then Rz(theta) Rx(alpha), whose URDF
-``rpy`` is exactly (alpha, 0, theta): no decomposition near a singularity. Only the base and
-tool rotations are decomposed into rpy (general rotations).
+frame is *joint i's frame* (:mod:`dynid.model.joint_frames`: where each joint sits, and DH frame
+i in link i's frame, K_i). Every constant rotation between consecutive frames is then
+Rz(theta) Rx(alpha), whose URDF ``rpy`` is exactly (alpha, 0, theta): no decomposition near a
+singularity. Only the base and tool rotations are decomposed into rpy (general rotations).
 
 Each link's inertial is written about its centre of mass with an ``<origin>`` whose axes are
 those of DH frame i (rpy of K_i), so the inertia tensor is the robot's, unrotated. The rotor
@@ -35,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..joint_frames import joint_frames
 from .consistency import (
     BODY_RULE,
     JOINT_RULE,
@@ -85,8 +80,7 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         if why:
             raise ValueError(f"robot: joint {i + 1} has {why}; in a URDF {JOINT_RULE}")
     links = [physical_form(robot.params[i]) for i in range(robot.n)]
-    dh = np.asarray(robot.dh, dtype=float)
-    standard = robot.convention == "standard"
+    frames = joint_frames(robot)
     root = ET.Element("robot", name=name)
     root.append(
         ET.Comment(
@@ -96,10 +90,9 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         )
     )
     ET.SubElement(root, "link", name="base_link")
-    parent_to_joint = robot.base @ (np.eye(4) if standard else _rx_tx(dh[0]))
     for i in range(robot.n):
-        a, alpha, d, theta = dh[i]
-        offset = _dh_offset(a, alpha, d, theta, standard)  # DH frame i in URDF link i's frame
+        parent_to_joint = frames.placements[i]
+        offset = frames.dh_offsets[i]  # DH frame i in URDF link i's frame
         mass, com, inertia = links[i]
         link = ET.SubElement(root, "link", name=f"link{i + 1}")
         inertial = ET.SubElement(link, "inertial")
@@ -149,12 +142,11 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         ET.SubElement(
             joint, "dynamics", damping=_number(robot.Fv[i]), friction=_number(robot.Fs[i])
         )
-        parent_to_joint = offset if standard or i + 1 == robot.n else offset @ _rx_tx(dh[i + 1])
     ET.SubElement(root, "link", name="tool")
     tool_joint = ET.SubElement(root, "joint", name="tool_joint", type="fixed")
     ET.SubElement(tool_joint, "parent", link=f"link{robot.n}")
     ET.SubElement(tool_joint, "child", link="tool")
-    tool = parent_to_joint @ robot.tool
+    tool = frames.tool
     ET.SubElement(tool_joint, "origin", xyz=_vector(tool[:3, 3]), rpy=_vector(rpy(tool[:3, :3])))
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
@@ -197,27 +189,6 @@ def rpy(rotation: Array) -> Array:
             pitch,
             np.arctan2(rotation[1, 0], rotation[0, 0]),
         ]
-    )
-
-
-def _dh_offset(a: float, alpha: float, d: float, theta: float, standard: bool) -> Array:
-    """K_i: DH frame i in URDF link i's frame (see the module docstring)."""
-    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    pose = np.eye(4)
-    pose[:3, :3] = [[ct, -st, 0.0], [st, ct, 0.0], [0.0, 0.0, 1.0]]
-    pose[2, 3] = d
-    if standard:
-        pose[:3, :3] = pose[:3, :3] @ [[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]]
-        pose[:2, 3] = a * ct, a * st
-    return pose
-
-
-def _rx_tx(row: Array) -> Array:
-    """Rx(alpha_{i-1}) Tx(a_{i-1}) of a modified row."""
-    a, alpha = row[0], row[1]
-    ca, sa = np.cos(alpha), np.sin(alpha)
-    return np.array(
-        [[1.0, 0.0, 0.0, a], [0.0, ca, -sa, 0.0], [0.0, sa, ca, 0.0], [0.0, 0.0, 0.0, 1.0]]
     )
 
 
