@@ -204,7 +204,14 @@ def export(args: argparse.Namespace) -> None:
     from ..export.result_files import export_robot
 
     written = export_robot(
-        args.source, args.urdf, mjcf=args.mjcf, name=args.name, overwrite=args.overwrite
+        args.source,
+        args.urdf,
+        mjcf=args.mjcf,
+        into=args.into,
+        base_link=getattr(args, "base_link", None),
+        tip_link=getattr(args, "tip_link", None),
+        name=args.name,
+        overwrite=args.overwrite,
     )
     print(f"wrote {', '.join(map(str, written))}", flush=True)
 

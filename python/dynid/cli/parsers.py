@@ -150,6 +150,13 @@ def _add_export(subcommands: Any) -> None:
     p.add_argument("source", metavar="SOURCE", help="result folder/result.json, model or URDF")
     p.add_argument("--urdf", metavar="FILE", help="the URDF file to write")
     p.add_argument(
+        "--into",
+        metavar="USER_URDF",
+        help="with --urdf: write into a copy of your own URDF of the arm (its inertials and "
+        "<dynamics> replaced, names, meshes, limits, ros2_control/Gazebo tags and comments "
+        "kept; docs/export.md)",
+    )
+    p.add_argument(
         "--mjcf",
         metavar="FILE",
         help="the MuJoCo MJCF file to write (armature = Ia, damping = Fv, frictionloss = Fs; "

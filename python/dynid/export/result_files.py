@@ -415,17 +415,27 @@ def export_robot(
     urdf: PathLike | None = None,
     *,
     mjcf: PathLike | None = None,
+    into: PathLike | None = None,
+    base_link: str | None = None,
+    tip_link: str | None = None,
     name: str | None = None,
     overwrite: bool = False,
 ) -> list[Path]:
     """Write the robot of ``source`` as URDF (``urdf``) and/or MuJoCo MJCF (``mjcf``; at least
     one) for ``dynid export``: ``source`` is a result folder or ``result.json`` of a physically
     consistent identification, or anything :func:`~dynid.model.model_files.load_model` reads (a
-    built-in name, a model file, a URDF). A least-squares result holds base parameters only, not
-    a robot: a ValueError says so. Returns the files written. Both files are checked before
+    built-in name, a model file, a URDF). With ``into`` (the user's own URDF of the arm, its
+    chain from ``base_link`` to ``tip_link``), ``urdf`` is that file with the robot's inertials
+    and drive terms in place of its own and everything else kept (:mod:`.urdf_into`); without,
+    a fresh URDF of the DH model. A least-squares result holds base parameters only, not a
+    robot: a ValueError says so. Returns the files written. Both files are checked before
     either is written (an existing file without ``overwrite``, a robot the format refuses)."""
+    from ..model.urdf.writing import write_urdf
     from .mjcf import mjcf_text, write_mjcf
+    from .urdf_into import urdf_into_text
 
+    if into is not None and urdf is None:
+        raise ValueError("into: the user's URDF to update needs --urdf OUT, the file to write")
     if urdf is None and mjcf is None:
         raise ValueError("urdf, mjcf: give at least one file to write (--urdf FILE, --mjcf FILE)")
     loaded = load_model_or_result(source)
@@ -448,8 +458,16 @@ def export_robot(
             )
     if mjcf is not None:
         mjcf_text(robot, name)  # refused before anything is written
+    updated = (
+        urdf_into_text(robot, into, base_link=base_link, tip_link=tip_link)
+        if into is not None
+        else None
+    )
     written = []
-    if urdf is not None:
+    if updated is not None:
+        assert urdf is not None
+        written.append(write_urdf(updated, urdf, overwrite=overwrite))
+    elif urdf is not None:
         robot.to_urdf(name=name, path=urdf, overwrite=overwrite)
         written.append(Path(urdf))
     if mjcf is not None:
