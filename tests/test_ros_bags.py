@@ -27,7 +27,8 @@ from test_log_identification import fourier_log
 
 rosbags = pytest.importorskip("rosbags")  # the dynid[ros] extra (requirements/test.txt)
 from rosbags.rosbag1 import Writer as Writer1  # noqa: E402
-from rosbags.rosbag2 import StoragePlugin, Writer as Writer2  # noqa: E402
+from rosbags.rosbag2 import StoragePlugin  # noqa: E402
+from rosbags.rosbag2 import Writer as Writer2  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -50,7 +51,7 @@ def _arm() -> dynid.Robot:
 def _message_names(arm: dynid.Robot, k: int, switch: int) -> tuple[list[str], list[int]]:
     """The name list of message k and, per entry, the model joint it is (-1: the gripper)."""
     order = list(FIRST_ORDER if k < switch else SECOND_ORDER)
-    index = order[:2] + [-1] + order[2:]
+    index = [*order[:2], -1, *order[2:]]
     return [GRIPPER if j < 0 else arm.joint_names[j] for j in index], index
 
 
@@ -82,7 +83,7 @@ def write_bag(
         text = writer.add_connection("/robot_mode", STRING, typestore=store)
         switch = log.T // 2
         for k in range(log.T):
-            ns = EPOCH_NS + int(round(log.t[k] * 1e9))
+            ns = EPOCH_NS + int(np.rint(log.t[k] * 1e9))
             stamp = types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
             stamps.append((ns // 10**9, ns % 10**9))
             header_fields = {"stamp": stamp, "frame_id": ""}
@@ -224,7 +225,7 @@ def test_no_joint_state_topic(tmp_path) -> None:
     with Writer2(tmp_path / "bag", version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         text = writer.add_connection("/robot_mode", STRING, typestore=store)
         writer.write(text, 1, store.serialize_cdr(store.types[STRING](data="idle"), STRING))
-    with pytest.raises(ValueError, match="no sensor_msgs/msg/JointState topic.*/robot_mode"):
+    with pytest.raises(ValueError, match=r"no sensor_msgs/msg/JointState topic.*/robot_mode"):
         read_ros_bag(tmp_path / "bag", joint_names=["a"])
 
 
@@ -252,10 +253,10 @@ def test_bad_arguments(simulated, bags, tmp_path) -> None:
     (tmp_path / "log.csv").write_text("t,q1,tau1\n0,0,0\n0.01,0,0\n")
     with pytest.raises(ValueError, match="topic: only for ROS bags"):
         load_log(tmp_path / "log.csv", topic="/joint_states")
-    with pytest.raises(ValueError, match="without metadata.yaml"):
+    with pytest.raises(ValueError, match=r"without metadata\.yaml"):
         load_log(tmp_path, joint_names=arm.joint_names)
     (tmp_path / "broken.mcap").write_bytes(b"not a bag")
-    with pytest.raises(ValueError, match="broken.mcap: not a readable ROS bag"):
+    with pytest.raises(ValueError, match=r"broken\.mcap: not a readable ROS bag"):
         load_log(tmp_path / "broken.mcap", joint_names=arm.joint_names)
 
 

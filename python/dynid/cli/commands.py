@@ -32,7 +32,10 @@ def log_options(args: argparse.Namespace, joint_names: Any = None) -> dict[str, 
 def ros_bag_options(args: argparse.Namespace, joint_names: Any) -> dict[str, Any]:
     """``load_log``'s options for ROS bags (docs/data.md, "ROS bags"): --topic, the model's
     joint names, --current (the effort is motor current)."""
-    options: dict[str, Any] = {"joint_names": joint_names, "current": getattr(args, "current", False)}
+    options: dict[str, Any] = {
+        "joint_names": joint_names,
+        "current": getattr(args, "current", False),
+    }
     if args.topic is not None:
         options["topic"] = args.topic
     return options

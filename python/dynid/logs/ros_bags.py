@@ -45,7 +45,7 @@ def read_ros_bag(
     path: str | Path,
     *,
     topic: str | None = None,
-    joint_names: Sequence[str],
+    joint_names: Sequence[str] | None,
     current: bool = False,
 ) -> Log:
     """The JointState messages of ``topic`` in the bag at ``path``, joints in the order of
@@ -117,7 +117,9 @@ def _topic(topics: dict[str, Any], topic: str | None) -> str:
     listed = ", ".join(f"{name} ({info.msgtype})" for name, info in sorted(topics.items()))
     if topic is not None:
         if topic not in topics:
-            raise ValueError(f"topic: no topic {topic!r} in the bag; its topics: {listed or 'none'}")
+            raise ValueError(
+                f"topic: no topic {topic!r} in the bag; its topics: {listed or 'none'}"
+            )
         if topics[topic].msgtype != JOINT_STATE:
             raise ValueError(
                 f"topic: {topic!r} holds {topics[topic].msgtype}, not {JOINT_STATE}; "
@@ -125,8 +127,10 @@ def _topic(topics: dict[str, Any], topic: str | None) -> str:
             )
         return topic
     if len(states) != 1:
-        found = f"{len(states)} {JOINT_STATE} topics ({', '.join(states)})" if states else (
-            f"no {JOINT_STATE} topic"
+        found = (
+            f"{len(states)} {JOINT_STATE} topics ({', '.join(states)})"
+            if states
+            else (f"no {JOINT_STATE} topic")
         )
         raise ValueError(
             f"topic: the bag has {found}; choose one with topic= / --topic; "
@@ -149,7 +153,7 @@ def _joint_states(
     orders: set[tuple[str, ...]] = set()
     ignored: set[str] = set()
     last: tuple[str, ...] | None = None
-    pick = np.empty(0, dtype=int)
+    pick: np.ndarray = np.empty(0, dtype=int)
     for k, msg in enumerate(messages):
         stamp = msg.header.stamp
         t[k] = stamp.sec + stamp.nanosec * 1e-9
@@ -191,9 +195,11 @@ def _joint_states(
         extra.append(f"{reordered} messages reordered by header stamp")
     if extra:
         note += "; " + "; ".join(extra)
-    arrays = {"t": t, "q": q, "tau": tau, "qd": qd if velocity_everywhere else None}
     return Log(
-        **{k: v[order_by_stamp] if v is not None else None for k, v in arrays.items()},
+        t=t[order_by_stamp],
+        q=q[order_by_stamp],
+        tau=tau[order_by_stamp],
+        qd=qd[order_by_stamp] if velocity_everywhere else None,
         source=str(path),
         notes=[note],
     )

@@ -31,9 +31,10 @@ class Robot(_core.Model):
     ``jacobian``, and docs/uses.md's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
     ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
 
-    Every field (``name``, ``joint_names``, the DH table, gravity, ``base``, ``tool``, ``qlim``, ``params``, the
-    drive terms, ``transmission``) is held by the C++ model; :mod:`dynid.model.robot_fields` lists
-    them once for copies, pickles, equality, files and ``dynid info``.
+    Every field (``name``, ``joint_names``, the DH table, gravity, ``base``, ``tool``, ``qlim``,
+    ``params``, the drive terms, ``transmission``) is held by the C++ model;
+    :mod:`dynid.model.robot_fields` lists them once for copies, pickles, equality, files and
+    ``dynid info``.
     """
 
     @classmethod

@@ -33,11 +33,18 @@ import numpy as np
 GROUPS = ("structure", "label", "placement", "limits", "links", "drive")
 #: How ``dynid info`` shows a field (:mod:`dynid.export.summary` has one layout per value):
 #: ``title``, the first line; ``joint table``, the DH table itself; ``joint columns``, columns
-#: of the DH table (one per ``label`` word); ``names``, one line of n words; ``transform``, a 4 x 4 matrix on one line;
-#: ``links``, the parameter table; ``per joint``, one line of n numbers; ``matrix``, a titled
-#: block of rows.
+#: of the DH table (one per ``label`` word); ``names``, one line of n words after the ``label``;
+#: ``transform``, a 4 x 4 matrix on one line; ``links``, the parameter table; ``per joint``, one
+#: line of n numbers; ``matrix``, a titled block of rows.
 LAYOUTS = (
-    "title", "joint table", "joint columns", "names", "transform", "links", "per joint", "matrix"
+    "title",
+    "joint table",
+    "joint columns",
+    "names",
+    "transform",
+    "links",
+    "per joint",
+    "matrix",
 )
 
 
