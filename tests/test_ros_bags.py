@@ -21,7 +21,7 @@ import dynid
 from dynid.cli import main
 from dynid.export.result_files import load_result
 from dynid.logs import load_log
-from dynid.logs.ros_bags import read_ros_bag
+from dynid.logs.ros_bags import is_ros_bag, read_ros_bag
 from dynid.model.model_files import save_model
 from test_log_identification import fourier_log
 
@@ -242,6 +242,9 @@ def test_missing_joint_is_named(simulated, bags) -> None:
 def test_bad_arguments(simulated, bags, tmp_path) -> None:
     arm, _ = simulated
     path = bags["mcap"][0]
+    assert [is_ros_bag(p) for p in (path, "a.bag", "b.MCAP", "c.db3", "d.csv", "e.npz")] == [
+        True, True, True, True, False, False
+    ]  # fmt: skip
     with pytest.raises(ValueError, match="joint_names: a ROS bag's joints are matched by name"):
         load_log(path)
     with pytest.raises(ValueError, match="joint_names: expected distinct"):
