@@ -63,6 +63,7 @@ OTHER_STRUCTURE: dict[str, Any] = {
 #: A value away from the default for every other field (in each element where it can be).
 VALUES: dict[str, Any] = {
     "name": "every field",
+    "joint_names": ("shoulder", "slider", "wrist"),
     "gravity": np.array([0.5, -1.0, -9.7]),
     "base": _pose(0.3, [0.1, 0.2, 0.3]),
     "tool": _pose(-0.7, [0.02, 0.05, 0.12]),
@@ -76,6 +77,7 @@ VALUES: dict[str, Any] = {
 #: The defaults of a 3-joint RPR arm, written out (docs/conventions.md; docs/models.md).
 DEFAULTS: dict[str, Any] = {
     "name": "3-dof arm",
+    "joint_names": ("q1", "q2", "q3"),
     "gravity": np.array([0.0, 0.0, -9.81]),
     "base": np.eye(4),
     "tool": np.eye(4),
@@ -157,7 +159,7 @@ def test_model_files_keep_every_field(suffix, tmp_path) -> None:
 def test_model_files_leave_out_only_the_defaults_flagged_so() -> None:
     written = model_to_dict(_robot(DEFAULTS))
     omitted = {f.file_key for f in robot_fields.FIELDS if f.omit_default}
-    assert omitted == {"base", "tool", "transmission"}
+    assert omitted == {"joint_names", "base", "tool", "transmission"}
     assert set(written) == {"format"} | {f.file_key for f in robot_fields.FIELDS} - omitted
     assert set(model_to_dict(_robot())) == {"format"} | {f.file_key for f in robot_fields.FIELDS}
 

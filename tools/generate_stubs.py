@@ -134,6 +134,7 @@ SETTER_TYPES: dict[str, str] = {
     "Fs": ARRAY_LIKE,
     "transmission": f"{ARRAY_LIKE} | None",
     "name": "str",
+    "joint_names": "typing.Sequence[str]",
     "qlim": ARRAY_LIKE,
     "forgetting": "float",
     "max_variance": "float | None",
@@ -149,6 +150,8 @@ RETURN_TYPES: dict[str | tuple[str, ...], str] = {
 RETURN_REPLACEMENTS: dict[str, tuple[str, str]] = {
     # q, qd, qdd, tau and the measured q (None unless recorded)
     "_simulate": ("typing.Any]", f"{ARRAY} | None]"),
+    # a py::tuple of n strings
+    "joint_names": ("tuple", "tuple[str, ...]"),
 }
 
 DEF = re.compile(

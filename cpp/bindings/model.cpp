@@ -135,6 +135,31 @@ void bind_model(py::module_& m) {
           },
           "A label for printing; '<n>-dof arm' by default.")
       .def_property(
+          "joint_names",
+          [](const PyModel& self) {
+            py::tuple names(self.model->n());
+            for (int i = 0; i < self.model->n(); ++i) names[i] = self.model->joint_names()[i];
+            return names;
+          },
+          [](PyModel& self, py::handle value) {
+            // A str is a sequence too: "abc" would name three joints a, b, c.
+            if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
+              throw py::value_error("joint_names: expected a sequence of strings, got " +
+                                    std::string(py::repr(value)));
+            std::vector<std::string> names;
+            for (py::handle item : value) {
+              if (!py::isinstance<py::str>(item))
+                throw py::value_error("joint_names: expected strings, got " +
+                                      std::string(py::repr(item)));
+              names.push_back(item.cast<std::string>());
+            }
+            // std::invalid_argument (count, empty, repeated) reaches Python as a ValueError.
+            self.modify([&](Model& model) { model.set_joint_names(std::move(names)); });
+          },
+          "One name per joint (tuple of n strings), 'q1'..'qn' by default; Robot.from_urdf takes "
+          "the URDF's joint names. Logs that name their joints (ROS JointState) are matched to "
+          "them. ValueError naming joint_names unless n non-empty, distinct strings.")
+      .def_property(
           "qlim",
           [](const PyModel& self) {
             const RowMajorMatrixX limits = self.model->joint_limits();

@@ -50,6 +50,7 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   set_base(base);
   set_tool(tool);
   name_ = std::to_string(n_) + "-dof arm";
+  for (int i = 0; i < n_; ++i) joint_names_.push_back("q" + std::to_string(i + 1));
   qlim_.resize(n_, 2);
   for (int i = 0; i < n_; ++i) {
     const double limit = rows_[i].type == JointType::Revolute ? kPi : 1.0;
@@ -111,6 +112,21 @@ void Model::set_tool(const Matrix4& tool) {
 }
 
 void Model::set_name(std::string name) { name_ = std::move(name); }
+
+void Model::set_joint_names(std::vector<std::string> joint_names) {
+  if (static_cast<int>(joint_names.size()) != n_)
+    throw std::invalid_argument("joint_names: expected " + std::to_string(n_) + " names, got " +
+                                std::to_string(joint_names.size()));
+  for (std::size_t i = 0; i < joint_names.size(); ++i) {
+    if (joint_names[i].empty())
+      throw std::invalid_argument("joint_names: name " + std::to_string(i) + " is empty");
+    for (std::size_t k = 0; k < i; ++k)
+      if (joint_names[k] == joint_names[i])
+        throw std::invalid_argument("joint_names: '" + joint_names[i] + "' names joints " +
+                                    std::to_string(k) + " and " + std::to_string(i));
+  }
+  joint_names_ = std::move(joint_names);
+}
 
 void Model::set_joint_limits(const Eigen::Ref<const MatrixX>& qlim) {
   if (qlim.rows() != n_ || qlim.cols() != 2)

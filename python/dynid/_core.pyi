@@ -340,6 +340,13 @@ class Model:
     @gravity_vector.setter
     def gravity_vector(self, arg1: numpy.typing.ArrayLike) -> None: ...
     @property
+    def joint_names(self) -> tuple[str, ...]:
+        """
+        One name per joint (tuple of n strings), 'q1'..'qn' by default; Robot.from_urdf takes the URDF's joint names. Logs that name their joints (ROS JointState) are matched to them. ValueError naming joint_names unless n non-empty, distinct strings.
+        """
+    @joint_names.setter
+    def joint_names(self, arg1: typing.Sequence[str]) -> None: ...
+    @property
     def joint_types(self) -> str: ...
     @property
     def n(self) -> int:

@@ -204,6 +204,12 @@ int main() {
   reversed.col(0).setOnes();
   reversed.col(1).setZero();
   expect_rejected("Model", "qlim", [&] { editable.set_joint_limits(reversed); }, false);
+  expect_rejected("Model", "joint_names", [&] { editable.set_joint_names({"a"}); }, false);
+  std::vector<std::string> names(static_cast<std::size_t>(n), "a");  // n alike
+  expect_rejected("Model", "joint_names", [&] { editable.set_joint_names(names); }, false);
+  for (std::size_t i = 0; i < names.size(); ++i) names[i] = "j" + std::to_string(i);
+  names.back() = "";  // one empty
+  expect_rejected("Model", "joint_names", [&] { editable.set_joint_names(names); }, false);
   dynid::RecursiveLeastSquares rls(4);
   const MatrixX block = MatrixX::Ones(2, 4);
   expect_rejected(

@@ -59,6 +59,14 @@ class Model {
   const std::string& name() const { return name_; }
   void set_name(std::string name);
 
+  // One name per joint, "q1".."qn" by default (a URDF's joint names through Robot.from_urdf):
+  // what a log that names its joints (a sensor_msgs/JointState) is matched against. Data for
+  // the user of the model; no algorithm reads them. set_joint_names throws
+  // std::invalid_argument naming `joint_names` unless there are n names, none empty, no two
+  // alike.
+  const std::vector<std::string>& joint_names() const { return joint_names_; }
+  void set_joint_names(std::vector<std::string> joint_names);
+
   // Joint limits, n x 2 rows [lower, upper] (rad or m): (-pi, pi) for a revolute and (-1, 1) m
   // for a prismatic joint by default. Data for the user of the model (random configurations,
   // excitation, bounds); no algorithm reads them. set_joint_limits throws std::invalid_argument
@@ -125,6 +133,7 @@ class Model {
   Vector3 gravity_;
   Matrix4 base_, tool_;
   std::string name_;
+  std::vector<std::string> joint_names_;
   MatrixX qlim_;
   MatrixX parameters_;
   VectorX Ia_, Fv_, Fs_;

@@ -19,12 +19,26 @@ def _steps(total: int) -> Callable[[str], None]:
     return step
 
 
-def log_options(args: argparse.Namespace) -> dict[str, Any]:
-    """The ``load_log`` options given on the command line."""
+def log_options(args: argparse.Namespace, joint_names: Any = None) -> dict[str, Any]:
+    """The ``load_log`` options given on the command line; ``joint_names``: the model's, which
+    the joints of a ROS bag are matched to."""
     from ..logs.columns import parse_columns
 
     columns = parse_columns(args.columns) if args.columns is not None else None
-    return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+    options = {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+    return {**options, **ros_bag_options(args, joint_names)}
+
+
+def ros_bag_options(args: argparse.Namespace, joint_names: Any) -> dict[str, Any]:
+    """``load_log``'s options for ROS bags (docs/data.md, "ROS bags"): --topic, the model's
+    joint names, --current (the effort is motor current)."""
+    options: dict[str, Any] = {
+        "joint_names": joint_names,
+        "current": getattr(args, "current", False),
+    }
+    if args.topic is not None:
+        options["topic"] = args.topic
+    return options
 
 
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -70,12 +84,12 @@ def identify(args: argparse.Namespace) -> None:
     if args.friction and args.asymmetric_friction:
         raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
-    log = load_log(args.log, **log_options(args))
+    robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
+    log = load_log(args.log, **log_options(args, robot.joint_names))
     step(
         f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
         + (f" (first {args.skip} skipped)" if args.skip else "")
     )
-    robot = load_model(args.model)
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
     result = identify_log(
         log,
@@ -125,10 +139,10 @@ def identify_from_currents(args: argparse.Namespace) -> None:
         raise ValueError("--current: give exactly one of --payload FILE|NUMBERS, --payload-mass KG")
     payload = load_payload(args.payload) if args.payload is not None else None
     step = _steps(5)
-    log = load_log(args.log, **log_options(args))
-    loaded = load_log(args.payload_log, **log_options(args))
+    robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
+    log = load_log(args.log, **log_options(args, robot.joint_names))
+    loaded = load_log(args.payload_log, **log_options(args, robot.joint_names))
     step(f"logs {args.log} ({log.T} samples), {args.payload_log} ({loaded.T} samples, loaded)")
-    robot = load_model(args.model)
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
     gains = identify_drive_gains(
         robot,
@@ -165,7 +179,7 @@ def validate(args: argparse.Namespace) -> None:
     check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
     step = _steps(3)
     result = load_result(args.result)
-    log = load_log(args.log, **log_options(args))
+    log = load_log(args.log, **log_options(args, result.robot.joint_names))
     if args.current:
         from ..identification.drive_gains import torques_from_currents
 
@@ -225,7 +239,7 @@ def residual(args: argparse.Namespace) -> None:
     inputs = [args.model, args.log]
     check_output_path(args.output, args.overwrite, inputs=inputs)
     model = load_model_or_result(args.model)
-    log = load_log(args.log, **log_options(args))
+    log = load_log(args.log, **log_options(args, _joint_names(model)))
     result = residual_from_log(model, log, args.gain)
     with output_folder(args.output, args.overwrite, inputs=inputs) as staging:
         save_residual(result, staging / "residual.npz")
@@ -242,3 +256,8 @@ def info(args: argparse.Namespace) -> None:
     from ..model.model_files import load_model
 
     print(model_summary(load_model(args.model)))
+
+
+def _joint_names(model: Any) -> Any:
+    """The joint names of a model or a result's model (``load_model_or_result``)."""
+    return getattr(model, "robot", model).joint_names

@@ -272,6 +272,12 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
         help="unit of the log's time stamps (default: s, and a sampling rate outside 1 Hz to "
         "100 kHz is an error; with the unit given, a warning)",
     )
+    p.add_argument(
+        "--topic",
+        metavar="TOPIC",
+        help="ROS bag: the sensor_msgs/JointState topic to read (default: the bag's only one); "
+        "its joints are matched by name to the model's joint names (docs/data.md)",
+    )
 
 
 def _add_preparation(p: argparse.ArgumentParser) -> None:

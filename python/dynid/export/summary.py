@@ -111,6 +111,10 @@ def _per_joint(robot: Robot, field: RobotField) -> list[str]:
     return [f"  {field.key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, field.attribute))]
 
 
+def _names(robot: Robot, field: RobotField) -> list[str]:
+    return [f"  {field.label}: " + " ".join(getattr(robot, field.attribute))]
+
+
 def _matrix(robot: Robot, field: RobotField) -> list[str]:
     rows = getattr(robot, field.attribute)
     return [f"  {field.label}:"] + ["    " + " ".join(f"{v:>8.4g}" for v in row) for row in rows]
@@ -125,6 +129,7 @@ _LAYOUTS: dict[str, Callable[[Robot, RobotField], list[str]]] = {
     "title": _printed_elsewhere,
     "joint table": _printed_elsewhere,
     "joint columns": _printed_elsewhere,
+    "names": _names,
     "transform": _transform,
     "links": _links,
     "per joint": _per_joint,

@@ -226,8 +226,11 @@ def load_log(
     skip: int = 0,
     columns: Mapping[str, str] | None = None,
     time_unit: str | None = None,
+    topic: str | None = None,
+    joint_names: Sequence[str] | None = None,
+    current: bool = False,
 ) -> Log:
-    """Load a log from an ``.npz`` or ``.csv`` file (formats in ``docs/data.md``).
+    """Load a log from an ``.npz`` or ``.csv`` file or a ROS bag (formats in ``docs/data.md``).
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
     the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
@@ -237,20 +240,39 @@ def load_log(
     (outside PLAUSIBLE_RATE: nanosecond stamps read as seconds give 2e-7 Hz and a meaningless
     fit) is an error, unless ``time_unit`` was given (then a warning: the caller said what the
     stamps count); a position range no robot has is a warning.
+
+    A ROS bag (a ``.bag``, ``.mcap`` or ``.db3`` file, or a ROS 2 bag directory) is read by
+    :func:`dynid.logs.ros_bags.read_ros_bag` with ``topic``, ``joint_names`` (the model's: its
+    joints are matched by name) and ``current`` (the effort is motor current); other files
+    ignore ``joint_names`` and ``current``.
     """
     path = Path(path)
-    if not path.is_file():
+    bag = path.is_dir() or path.suffix.lower() in (".bag", ".mcap", ".db3")  # logs/ros_bags.py
+    if not bag and not path.is_file():
         raise FileNotFoundError(f"path: no such file: {path}")
     suffix = path.suffix.lower()
-    if suffix not in (".npz", ".csv"):
+    if not bag and suffix not in (".npz", ".csv"):
         raise ValueError(
-            f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv"
+            f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv, or a "
+            "ROS bag (.bag, .mcap, .db3, a ROS 2 bag directory)"
         )
+    if bag and (columns is not None or time_unit is not None):
+        raise ValueError(
+            "columns, time_unit: not for a ROS bag (joints are matched by name, time is read from "
+            "the header stamps)"
+        )
+    if not bag and topic is not None:
+        raise ValueError(f"topic: only for ROS bags, not {path.name}")
     skip = count(skip, "skip", 0)
     mapping = check_columns(columns) if columns is not None else None
     seconds = time_scale("s" if time_unit is None else time_unit)
     try:
-        log = _load_npz(path, mapping) if suffix == ".npz" else _load_csv(path, mapping)
+        if bag:
+            from .ros_bags import read_ros_bag  # rosbags (an optional extra) on first use
+
+            log = read_ros_bag(path, topic=topic, joint_names=joint_names, current=current)
+        else:
+            log = _load_npz(path, mapping) if suffix == ".npz" else _load_csv(path, mapping)
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
     if seconds != 1.0:

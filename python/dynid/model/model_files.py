@@ -191,18 +191,26 @@ def model_to_dict(robot: Robot, identified: bool = True) -> dict[str, Any]:
             data[f.file_key] = [dict(zip(keys, _floats(row))) for row in value]
         elif f.kind == "text":
             data[f.file_key] = str(value)
+        elif f.kind == "names":
+            data[f.file_key] = [str(v) for v in value]
         else:
             data[f.file_key] = _floats(value)
     return data
 
 
 def _value(value: Any, field: robot_fields.RobotField, n: int) -> Any:
-    """A settable field's value from a file: a string, or numbers of the field's shape. An empty
+    """A settable field's value from a file: a string, a list of strings (``names``), or numbers
+    of the field's shape. An empty
     text (``"name": ""``) means the default, as an absent one."""
     if field.kind == "text":
         if not isinstance(value, str):
             raise ValueError(f"{field.file_key}: expected a string, got {value!r}")
         return value or None
+    if field.kind == "names":
+        # the count, empty and repeated names are checked by the setter (ValueError naming it)
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise ValueError(f"{field.file_key}: expected a list of {n} strings, got {value!r:.60}")
+        return value
     return _numbers(value, field.file_key, field.shape_for(n))
 
 

@@ -31,9 +31,10 @@ class Robot(_core.Model):
     ``jacobian``, and docs/uses.md's ``rnea_derivatives``, ``jacobian_dot``, ``linearize``,
     ``cartesian_inertia``, ``cartesian_dynamics``) accept one sample (n,) or T samples (T, n).
 
-    Every field (``name``, the DH table, gravity, ``base``, ``tool``, ``qlim``, ``params``, the
-    drive terms, ``transmission``) is held by the C++ model; :mod:`dynid.model.robot_fields` lists
-    them once for copies, pickles, equality, files and ``dynid info``.
+    Every field (``name``, ``joint_names``, the DH table, gravity, ``base``, ``tool``, ``qlim``,
+    ``params``, the drive terms, ``transmission``) is held by the C++ model;
+    :mod:`dynid.model.robot_fields` lists them once for copies, pickles, equality, files and
+    ``dynid info``.
     """
 
     @classmethod
@@ -49,6 +50,7 @@ class Robot(_core.Model):
         qlim: ArrayLike | None = None,
         name: str | None = None,
         transmission: ArrayLike | None = None,
+        joint_names: Sequence[str] | None = None,
     ) -> Robot:
         """Build a robot from a DH table.
 
@@ -75,6 +77,9 @@ class Robot(_core.Model):
         transmission
             (n, n) transmission coupling T, motor velocities theta_dot = T qd (coupled wrists;
             docs/transmission.md); None means the identity (decoupled drives).
+        joint_names
+            n distinct non-empty names, matched to the names of a log's joints (a ROS
+            JointState, docs/data.md); None means ``q1``..``qn``.
         """
         expected = "dh: expected shape (n, 4) with rows [a, alpha, d, theta], got"
         try:
@@ -97,6 +102,8 @@ class Robot(_core.Model):
             robot.name = name
         if transmission is not None:
             robot.transmission = transmission
+        if joint_names is not None:
+            robot.joint_names = joint_names
         return robot
 
     @classmethod
@@ -118,7 +125,8 @@ class Robot(_core.Model):
         has z along each joint axis, theta/d offsets, and base and tool transforms such that
         ``fkine(q)`` is the pose of ``tip_link`` in ``base_link``'s frame (the world). Inertials
         become standard parameters in the DH frames, ``<limit>`` goes to ``qlim`` (continuous
-        joints: (-pi, pi)), ``<dynamics damping friction>`` to ``Fv`` and ``Fs``.
+        joints: (-pi, pi)), ``<dynamics damping friction>`` to ``Fv`` and ``Fs``, the joints' names
+        to ``joint_names``.
 
         ValueError (naming the joint, link or argument) for malformed XML, a branched tree
         without ``tip_link``, floating, planar or mimic joints on the chain, more than 64 movable
@@ -142,6 +150,7 @@ class Robot(_core.Model):
             model.tool,
             model.qlim,
             model.name,
+            joint_names=model.joint_names,
         )
         robot.Ia, robot.Fv, robot.Fs = model.Ia, model.Fv, model.Fs
         return robot

@@ -33,10 +33,19 @@ import numpy as np
 GROUPS = ("structure", "label", "placement", "limits", "links", "drive")
 #: How ``dynid info`` shows a field (:mod:`dynid.export.summary` has one layout per value):
 #: ``title``, the first line; ``joint table``, the DH table itself; ``joint columns``, columns
-#: of the DH table (one per ``label`` word); ``transform``, a 4 x 4 matrix on one line;
-#: ``links``, the parameter table; ``per joint``, one line of n numbers; ``matrix``, a titled
-#: block of rows.
-LAYOUTS = ("title", "joint table", "joint columns", "transform", "links", "per joint", "matrix")
+#: of the DH table (one per ``label`` word); ``names``, one line of n words after the ``label``;
+#: ``transform``, a 4 x 4 matrix on one line; ``links``, the parameter table; ``per joint``, one
+#: line of n numbers; ``matrix``, a titled block of rows.
+LAYOUTS = (
+    "title",
+    "joint table",
+    "joint columns",
+    "names",
+    "transform",
+    "links",
+    "per joint",
+    "matrix",
+)
 
 
 #: Flags a field may carry. ``required``: a model file must hold it. ``omit_default``: model
@@ -55,8 +64,9 @@ class RobotField:
     #: Its name in pickled state and in model and result files; the Robot's property unless
     #: ``attribute`` says otherwise.
     key: str
-    #: "text" (a string), "array" (float64 of ``shape``) or "dh" (the DH table, (n, 4): model
-    #: files hold it as rows of named values, :mod:`dynid.model.model_files`).
+    #: "text" (a string), "names" (a tuple of ``shape`` strings; a list in files), "array"
+    #: (float64 of ``shape``) or "dh" (the DH table, (n, 4): model files hold it as rows of named
+    #: values, :mod:`dynid.model.model_files`).
     kind: str
     #: Shape of an array; "n" stands for the number of joints.
     shape: tuple[int | str, ...]
@@ -126,6 +136,9 @@ FIELDS: tuple[RobotField, ...] = (
     RobotField("base",         "array", (4, 4),     "placement", "omit_default structural",
                "transform"),
     RobotField("tool",         "array", (4, 4),     "placement", "omit_default",  "transform"),
+    # Logs that name their joints (a ROS JointState) are matched to these (docs/data.md).
+    RobotField("joint_names",  "names", ("n",),     "label",     "omit_default",  "names",
+               label="joint names"),
     RobotField("qlim",         "array", ("n", 2),   "limits",    "",              "joint columns",
                label="qmin qmax"),
     RobotField("params",       "array", ("n", 10),  "links",     "identified",    "links"),
