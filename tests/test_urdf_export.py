@@ -90,10 +90,12 @@ def test_urdf_content() -> None:
     assert text.startswith('<?xml version="1.0"?>\n<robot name="lwr">')
     # Ia in a comment of each joint, with the value that reads back exactly
     for i, value in enumerate(robot.Ia, start=1):
-        assert (
-            f'<joint name="joint{i}" type="revolute">\n    <!-- dynid: Ia="{float(value)!r}"'
-            in text
-        )
+        assert f'<joint name="q{i}" type="revolute">\n    <!-- dynid: Ia="{float(value)!r}"' in text
+    # The joints carry the robot's joint names (a URDF's own, read back as they were).
+    named = robot.copy()
+    named.joint_names = [f"lwr_a{i}" for i in range(1, 8)]
+    again = dynid.Robot.from_urdf(named.to_urdf())
+    assert again.joint_names == named.joint_names
     assert text.count("<link ") == robot.n + 2 and text.count("<joint ") == robot.n + 1
     assert '<axis xyz="0 0 1" />' in text
     assert "-0.0" not in re.findall(r"[-+.\de]+", text)  # no negative zeros printed

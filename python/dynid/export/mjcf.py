@@ -59,7 +59,7 @@ def mjcf_text(robot: Any, name: str | None = None) -> str:
         why = joint_inconsistency(robot.Ia[i], robot.Fv[i], robot.Fs[i])
         if why:
             raise ValueError(f"robot: joint {i + 1} has {why}; in MJCF {JOINT_RULE}")
-    names = _joint_names(robot)
+    names = list(robot.joint_names)
     frames = joint_frames(robot)
     root = ET.Element("mujoco", model=name)
     root.append(
@@ -124,11 +124,6 @@ def write_mjcf(
     """Write ``robot`` as MJCF to ``path``, atomically (the file is whole or absent); an
     existing file is a ValueError unless ``overwrite``."""
     return write_text(mjcf_text(robot, name), path, overwrite=overwrite)
-
-
-def _joint_names(robot: Any) -> list[str]:
-    names = getattr(robot, "joint_names", None)
-    return list(names) if names else [f"joint{i + 1}" for i in range(robot.n)]
 
 
 def _quaternion(rotation: NDArray[np.float64]) -> NDArray[np.float64]:

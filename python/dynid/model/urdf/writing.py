@@ -1,8 +1,9 @@
 """A DH robot written as URDF text (docs/urdf.md), and written to a file atomically.
 
 Links ``base_link`` (the world, massless), ``link1`` .. ``linkn`` (the DH links) and ``tool``
-(massless, at the tool transform); joints ``joint1`` .. ``jointn`` (revolute or prismatic,
-axis z) and the fixed ``tool_joint``.
+(massless, at the tool transform); joints named by ``robot.joint_names`` (``q1`` .. ``qn`` by
+default, a URDF's own names when the robot was read from one; revolute or prismatic, axis z) and
+the fixed ``tool_joint``.
 
 URDF moves a joint's child about (along) an axis through the child's origin, so URDF link i's
 frame is *joint i's frame* (:mod:`dynid.model.joint_frames`: where each joint sits, and DH frame
@@ -63,6 +64,9 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         raise ValueError(
             f"name: expected characters that XML 1.0 allows (no control characters), got {name!r}"
         )
+    bad = [joint for joint in robot.joint_names if _NOT_XML.search(joint)]
+    if bad:
+        raise ValueError(f"joint_names: {bad[0]!r} has characters that XML 1.0 does not allow")
     if robot.coupled:
         raise ValueError(
             "transmission: a robot with coupled drives (transmission not the identity) cannot be "
@@ -119,7 +123,7 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
             },
         )
         kind = "prismatic" if robot.joint_types[i] == "P" else "revolute"
-        joint = ET.SubElement(root, "joint", name=f"joint{i + 1}", type=kind)
+        joint = ET.SubElement(root, "joint", name=robot.joint_names[i], type=kind)
         joint.append(
             ET.Comment(
                 f' dynid: Ia="{_number(robot.Ia[i])}" (reflected rotor inertia [kg m^2], '
