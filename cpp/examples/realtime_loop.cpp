@@ -47,7 +47,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kJoints = 7;
 constexpr double kPeriod = 1e-3;  // 1 kHz
 
-// KUKA LWR-IV kinematics: Table I of Gaz, Flacco, Ferraguti, De Luca (ICRA 2014), standard DH,
+// KUKA LWR-IV kinematics: Table I of Gaz, Flacco, De Luca (ICRA 2014), standard DH,
 // rows [a, alpha, d, theta], all joints revolute.
 dynid::Model make_lwr4() {
   const double alpha[kJoints] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0.0};

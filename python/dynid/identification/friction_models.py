@@ -1,7 +1,8 @@
 """Joint friction models of the identification regressor: none, symmetric, asymmetric.
 
-The symmetric model is the lecture's (Robotics 2, "Dynamic model with friction"; Gaz et al.,
-paper eq. (5)): tau_f,j = Fv_j qd_j + Fs_j sign(qd_j), columns of :meth:`dynid.Robot.regressor`
+The symmetric model is the lecture's (Robotics 2 notes p. 11, "Adding dynamic terms":
+viscous and dry friction at the joints; the paper neglects friction in its link equations):
+tau_f,j = Fv_j qd_j + Fs_j sign(qd_j), columns of :meth:`dynid.Robot.regressor`
 (``friction=True``) and drive terms of the robot. The asymmetric model lets each coefficient
 depend on the direction of motion; its viscous part is FloBaRoID's asymmetric viscous friction
 ("identifySymmetricVelFriction: 0": Fv+ for qd > 0, Fv- for qd < 0, both >= 0 in its SDP), and
