@@ -24,7 +24,22 @@ def log_options(args: argparse.Namespace) -> dict[str, Any]:
     from ..logs.columns import parse_columns
 
     columns = parse_columns(args.columns) if args.columns is not None else None
-    return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+    return {
+        "skip": args.skip,
+        "columns": columns,
+        "time_unit": args.time_unit,
+        "current": getattr(args, "current", False),  # motor currents as tau (UR RTDE)
+        "drop_nonfinite": args.drop_nonfinite,
+    }
+
+
+def log_reading(log: Any) -> str:
+    """The log's format and what reading it did (rows dropped, time unit converted): the notes
+    after its load note, for the command's output."""
+    loaded = [i for i, note in enumerate(log.notes) if note.startswith("loaded from ")]
+    after = log.notes[loaded[-1] + 1 :] if loaded else []
+    done = [note for note in after if not note.startswith("skipped the first")]
+    return f"{log.format or 'unknown format'}" + (f"; {'; '.join(done)}" if done else "")
 
 
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -72,8 +87,8 @@ def identify(args: argparse.Namespace) -> None:
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
     step(
-        f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
-        + (f" (first {args.skip} skipped)" if args.skip else "")
+        f"log {args.log} ({log_reading(log)}): {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, "
+        f"{log.duration:.4g} s" + (f" (first {args.skip} skipped)" if args.skip else "")
     )
     robot = load_model(args.model)
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
@@ -127,7 +142,10 @@ def identify_from_currents(args: argparse.Namespace) -> None:
     step = _steps(5)
     log = load_log(args.log, **log_options(args))
     loaded = load_log(args.payload_log, **log_options(args))
-    step(f"logs {args.log} ({log.T} samples), {args.payload_log} ({loaded.T} samples, loaded)")
+    step(
+        f"logs {args.log} ({log_reading(log)}; {log.T} samples), {args.payload_log} "
+        f"({log_reading(loaded)}; {loaded.T} samples, loaded)"
+    )
     robot = load_model(args.model)
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
     gains = identify_drive_gains(
@@ -178,7 +196,7 @@ def validate(args: argparse.Namespace) -> None:
     validation = run_validation(result, log, preparation=preparation_options(args))
     step(
         f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
-        f"log {args.log}: {validation.log.T} samples"
+        f"log {args.log} ({log_reading(log)}): {validation.log.T} samples"
     )
     for note in validation.notes:
         print(f"note: {note} (--cutoff)", flush=True)

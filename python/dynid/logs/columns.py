@@ -100,11 +100,18 @@ def matching(
     regex = pattern if isinstance(pattern, re.Pattern) else pattern_regex(pattern)
     found = [name for name in names if regex.match(name)]
     if not found:
-        pattern = pattern.pattern if isinstance(pattern, re.Pattern) else pattern
+        pattern = readable(pattern) if isinstance(pattern, re.Pattern) else pattern
         raise ValueError(
             f"columns: nothing matches {pattern!r} for {signal}; found {name_list(names)}"
         )
     return sorted(found, key=_natural_key)
+
+
+def readable(regex: re.Pattern[str]) -> str:
+    """A format's column expression as a name for messages: ``state\\.q\\[\\d+\\]\\Z`` ->
+    ``state.q[N]``."""
+    text = regex.pattern.replace(r"\d+", "N").replace(r"\Z", "")
+    return re.sub(r"\\(.)", r"\1", text)
 
 
 def _natural_key(name: str) -> list[object]:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..columns import index_names, matching, time_scale
+from ..columns import index_names, matching, readable, time_scale
 from ..formats import ReadOptions
 from ..log_files import Log, check_finite
 from ..messages import name_list
@@ -34,7 +34,8 @@ def table_log(
     unit: str = "s",
     time_from: tuple[Sequence[str], Callable[..., NDArray[np.float64]]] | None = None,
 ) -> Log:
-    """The Log of ``table``: ``spec`` maps signals to columns (``options.columns`` overrides it);
+    """The Log of ``table``: ``spec`` maps signals to columns, ``options.columns`` overrides it
+    per signal (mapping ``q`` drops the format's ``qd`` and ``qdd``, which go with its ``q``);
     without a ``t`` in either, ``time_from`` = (column names, function of those columns) gives
     the time in seconds. ``unit`` is the time stamps' unit unless ``options.time_unit`` says."""
     if not table.has_header and not options.columns:
@@ -45,6 +46,8 @@ def table_log(
         )
     mapping: dict[str, str | re.Pattern[str]] = dict(spec)
     if options.columns:
+        if "q" in options.columns:  # other joints: the format's velocities no longer belong
+            mapping = {s: p for s, p in mapping.items() if s not in ("qd", "qdd")}
         mapping.update(options.columns)
     for required in ("q", "tau"):
         if required not in mapping:
@@ -105,7 +108,7 @@ def _find(
         names = {s: matching(p, table.names, s) for s, p in mapping.items()}
     if "t" in names and len(names["t"]) != 1:
         pattern = mapping.get("t", "")
-        shown = pattern.pattern if isinstance(pattern, re.Pattern) else pattern
+        shown = readable(pattern) if isinstance(pattern, re.Pattern) else pattern
         raise ValueError(
             f"columns: {shown!r} for t matches {name_list(names['t'])}; expected one time column"
         )
@@ -126,7 +129,7 @@ def _span(names: list[str]) -> str:
 
 
 def _shown(mapping: Mapping[str, str | re.Pattern[str]]) -> dict[str, str]:
-    return {s: p.pattern if isinstance(p, re.Pattern) else p for s, p in mapping.items()}
+    return {s: readable(p) if isinstance(p, re.Pattern) else p for s, p in mapping.items()}
 
 
 def finish(
