@@ -103,7 +103,7 @@ def write_libfranka(path: Path, m: Motion, *, old_header: bool = False) -> None:
         for k in range(m.t.size):
             state_values = [m.q[k], m.q[k], m.qd[k], m.qd[k], m.tau[k], zeros7]
             command_values = [m.q[k], m.qd[k], pose, twist, zeros7]
-            fields = [str(int(round(m.t[k] * 1000))), cpp_default(1.0)]
+            fields = [str(round(m.t[k] * 1000)), cpp_default(1.0)]
             fields += [cpp_default(x) for arr in state_values + command_values for x in arr]
             handle.write(",".join(fields) + "\n")
 
@@ -147,7 +147,7 @@ def write_rostopic_csv(path: Path, m: Motion, names: list[str], stamp0: int) -> 
     with path.open("w", encoding="utf-8") as handle:
         handle.write(",".join(header) + "\n")
         for k in range(m.t.size):
-            fields = [str(stamps[k]), str(k), str(stamps[k]), ""] + list(names)
+            fields = [str(stamps[k]), str(k), str(stamps[k]), "", *names]
             for values in (m.q[k], m.qd[k], m.tau[k]):
                 fields += [repr(float(x)) for x in values]
             handle.write(",".join(fields) + "\n")

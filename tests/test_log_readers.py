@@ -10,6 +10,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+import dynid
+from dynid.logs import load_log, save_log
+from dynid.logs.formats import detect, formats
 from log_writers import (
     Motion,
     simulate,
@@ -18,10 +22,6 @@ from log_writers import (
     write_rostopic_csv,
     write_rtde,
 )
-
-import dynid
-from dynid.logs import load_log, save_log
-from dynid.logs.formats import detect, formats
 
 
 @pytest.fixture(scope="module")

@@ -11,12 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from log_writers import Motion, simulate, write_libfranka, write_rtde
 
 import dynid
 from dynid.cli.main import main
 from dynid.identification.log_identification import identify_log
 from dynid.logs import load_log
+from log_writers import Motion, simulate, write_libfranka, write_rtde
 
 
 def true_base(robot: dynid.Robot) -> np.ndarray:

@@ -92,9 +92,7 @@ def index_names(pattern: str, width: int, signal: str) -> list[str]:
     return [str(c) for c in range(start, stop)]
 
 
-def matching(
-    pattern: str | re.Pattern[str], names: Sequence[str], signal: str
-) -> list[str]:
+def matching(pattern: str | re.Pattern[str], names: Sequence[str], signal: str) -> list[str]:
     """The names matching ``pattern`` (a pattern as in this module's docstring, or a compiled
     regular expression) in natural order; a ValueError naming the signal if none."""
     regex = pattern if isinstance(pattern, re.Pattern) else pattern_regex(pattern)

@@ -106,5 +106,4 @@ def _head(path: Path) -> str:
     if b"\0" in raw:
         return ""
     # A multi-byte character may be cut at the end of the block: ignore that, not the file.
-    text = raw.decode("utf-8", errors="ignore")
-    return text
+    return raw.decode("utf-8", errors="ignore")

@@ -5,8 +5,8 @@ A :class:`Log` holds time, joint positions and joint torques, with velocities an
 when the recording has them. ``load_log`` finds the file's format in the registry
 (:mod:`dynid.logs.formats`; the readers, one per format, are in :mod:`dynid.logs.readers`) and
 adds what every format shares: ``skip`` and the plausibility of the time base. ``save_log``
-writes dynid's NPZ and CSV (``docs/data.md``). Preparing a log for identification (filtering, differentiation, decimation, dropping
-samples) is :mod:`dynid.logs.preparation`.
+writes dynid's NPZ and CSV (``docs/data.md``). Preparing a log for identification (filtering,
+differentiation, decimation, dropping samples) is :mod:`dynid.logs.preparation`.
 """
 
 from __future__ import annotations
@@ -333,12 +333,9 @@ def save_log(log: Log, path: PathLike) -> None:
     if suffix == ".npz":
         arrays = {name: getattr(log, name) for name in ("t", *present)}
         with path.open("wb") as handle:  # a handle: np.savez would append ".npz" to "x.NPZ"
-            np.savez(
-                handle,
-                **arrays,
-                notes=np.asarray(log.notes, dtype=str),
-                **({"format": np.asarray(log.format)} if log.format else {}),
-            )
+            if log.format:
+                arrays["format"] = np.asarray(log.format)
+            np.savez(handle, **arrays, notes=np.asarray(log.notes, dtype=str))
     elif suffix == ".csv":
         order = [name for name in ("q", "qd", "qdd", "tau") if name in present]
         header = ["t"] + [f"{name}{j}" for name in order for j in range(1, log.n + 1)]

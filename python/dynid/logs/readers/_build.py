@@ -151,7 +151,7 @@ def finish(
     lengths = {len(a) for a in arrays.values()}
     if len(lengths) == 1 and all(np.ndim(a) in (1, 2) for a in arrays.values()):
         T = lengths.pop()
-        bad = np.zeros(T, dtype=bool)
+        bad: NDArray[np.bool_] = np.zeros(T, dtype=bool)
         for a in arrays.values():
             if np.asarray(a).dtype.kind in "fc":
                 bad |= ~np.isfinite(np.asarray(a)).reshape(T, -1).all(axis=1)

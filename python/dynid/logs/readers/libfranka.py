@@ -32,7 +32,12 @@ def read(path: Path, options: ReadOptions) -> Log:
         raise ValueError(
             "current: a libfranka log has no motor currents (state.tau_J are joint torques)"
         )
-    spec = {"t": "time", "q": _joint("q"), "qd": _joint("dq"), "tau": _joint("tau_J")}
+    spec: dict[str, str | re.Pattern[str]] = {
+        "t": "time",
+        "q": _joint("q"),
+        "qd": _joint("dq"),
+        "tau": _joint("tau_J"),
+    }
     return table_log(path, read_table(path), options, spec, fmt=NAME, unit="ms")
 
 

@@ -68,8 +68,9 @@ def _is_v73(path: Path) -> bool:
         header = handle.read(128)
     if len(header) < 128:
         return False
-    order = "little" if header[126:128] == b"IM" else "big"
-    return int.from_bytes(header[124:126], order) == _HDF5_VERSION
+    little = header[126:128] == b"IM"
+    version = int.from_bytes(header[124:126], "little" if little else "big")
+    return version == _HDF5_VERSION
 
 
 def recognises(path: Path, head: str) -> bool:

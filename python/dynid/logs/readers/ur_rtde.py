@@ -28,7 +28,7 @@ def _joint(field: str) -> re.Pattern[str]:
 
 
 def read(path: Path, options: ReadOptions) -> Log:
-    spec = {
+    spec: dict[str, str | re.Pattern[str]] = {
         "t": "timestamp",
         "q": _joint("actual_q"),
         "qd": _joint("actual_qd"),
