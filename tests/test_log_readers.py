@@ -273,3 +273,8 @@ def test_unknown_extension_lists_the_readable_ones(tmp_path: Path):
     path.write_text("x")
     with pytest.raises(ValueError, match=re.escape("expected .npz or .csv, or .mat")):
         load_log(path)
+
+
+def test_a_folder_is_refused_unless_a_format_reads_folders(tmp_path: Path):
+    with pytest.raises(ValueError, match="is a folder; no log format reads a folder"):
+        load_log(tmp_path)

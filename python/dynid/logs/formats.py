@@ -46,10 +46,15 @@ class LogFormat:
     ("" for a binary file); ``read(path, options)`` returns the checked Log."""
 
     name: str  #: shown in the output and in result.json, e.g. "UR RTDE CSV"
-    suffixes: tuple[str, ...]  #: lower case, with the dot: (".csv",)
+    #: lower case, with the dot: (".csv",); DIRECTORY for a format stored as a folder (a ROS 2
+    #: bag: metadata.yaml beside its .db3 or .mcap files)
+    suffixes: tuple[str, ...]
     recognises: Callable[[Path, str], bool]
     read: Callable[[Path, ReadOptions], Log]
 
+
+#: The "suffix" of a folder given as the log (``recognises`` then gets "" as the head).
+DIRECTORY = "/"
 
 _SPECIFIC: list[LogFormat] = []
 _GENERIC: list[LogFormat] = []
@@ -81,17 +86,19 @@ def suffixes() -> list[str]:
 def detect(path: str | Path) -> LogFormat:
     """The format of the file ``path``: by suffix, then by its first bytes."""
     path = Path(path)
-    suffix = path.suffix.lower()
+    suffix = DIRECTORY if path.is_dir() else path.suffix.lower()
     candidates = [fmt for fmt in formats() if suffix in fmt.suffixes]
+    if not candidates and suffix == DIRECTORY:
+        raise ValueError(f"path: {path} is a folder; no log format reads a folder")
     if not candidates:
-        known = suffixes()
+        known = [s for s in suffixes() if s != DIRECTORY]
         own = [s for s in (".npz", ".csv") if s in known]
         others = [s for s in known if s not in own]
         raise ValueError(
             f"path: unknown extension {path.suffix!r} of {path}; expected {' or '.join(own)}"
             + (f", or {', '.join(others)}" if others else "")
         )
-    head = _head(path)
+    head = "" if suffix == DIRECTORY else _head(path)
     for fmt in candidates:
         if fmt.recognises(path, head):
             return fmt

@@ -245,7 +245,7 @@ def load_log(
     from .formats import ReadOptions, detect
 
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():  # a folder is a log too where a format reads one (ROS 2 bags)
         raise FileNotFoundError(f"path: no such file: {path}")
     skip = count(skip, "skip", 0)
     if time_unit is not None:

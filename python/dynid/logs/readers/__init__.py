@@ -13,9 +13,13 @@ from . import fri, generic_csv, libfranka, matlab, npz, ur_rtde
 register(ur_rtde.FORMAT)
 register(libfranka.FORMAT)
 register(fri.FORMAT)
-# ROS bags (.bag, .db3, .mcap): logs/ros_bags.py's read_ros_bag(path, *, topic, joint_names,
-# current), wrapped in a LogFormat and registered here (its own suffixes, so its place in the
-# order does not matter).
+# ROS bags: logs/ros_bags.py's read_ros_bag(path, *, topic, joint_names, current) (another
+# session's work) is registered here at its merge, e.g. as
+#     register(LogFormat("ROS bag", (".bag", ".db3", ".mcap", DIRECTORY), lambda p, head: True,
+#         lambda p, o: ros_bags.read_ros_bag(p, topic=o.topic, joint_names=o.joint_names,
+#                                            current=o.current)))
+# (its own suffixes, so its place in the order does not matter; DIRECTORY from ..formats: a
+# ROS 2 bag is a folder).
 register(generic_csv.FORMAT, generic=True)
 register(npz.FORMAT, generic=True)
 register(matlab.FORMAT, generic=True)
