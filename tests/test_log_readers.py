@@ -278,3 +278,39 @@ def test_unknown_extension_lists_the_readable_ones(tmp_path: Path):
 def test_a_folder_is_refused_unless_a_format_reads_folders(tmp_path: Path):
     with pytest.raises(ValueError, match="is a folder; no log format reads a folder"):
         load_log(tmp_path)
+
+
+@pytest.mark.parametrize(
+    ("header", "match"),
+    [
+        (
+            "time,success_rate,state.q[0],state.q[1],state.dq[0],state.dq[1]",
+            r"nothing matches 'state.tau_J\[N\]' for tau; found time, success_rate, state.q\[0\]",
+        ),
+        (
+            "index,time,record_time_nsec,tsec,tnsec,mp1,mp2,et1,et2,dt",
+            r"nothing matches 'mtN' for tau; found index, time",
+        ),
+        ("timestamp actual_q_0 actual_q_1", r"nothing matches 'timestamp'|'target_moment_N'"),
+    ],
+)
+def test_a_robot_format_missing_a_column_names_the_file_and_the_column(
+    tmp_path: Path, header: str, match: str
+):
+    delimiter = " " if header.startswith("timestamp") else ","
+    width = len(header.split(delimiter))
+    rows = [delimiter.join(str(k + 1 + 0.001 * c) for c in range(width)) for k in range(3)]
+    path = tmp_path / "robot.csv"
+    path.write_text(header + "\n" + "\n".join(rows) + "\n")
+    with pytest.raises(ValueError, match=match) as e:
+        load_log(path)
+    assert str(e.value).startswith(str(path)) and len(str(e.value)) < 300
+
+
+def test_libfranka_time_unit_given_overrides_its_milliseconds(tmp_path: Path, panda_motion):
+    path = tmp_path / "log.csv"
+    write_libfranka(path, panda_motion)
+    default = load_log(path)
+    with pytest.warns(UserWarning, match="implausible"):  # ms read as us: 1 MHz
+        given = load_log(path, time_unit="us")
+    np.testing.assert_allclose(given.t, default.t * 1e-3, rtol=1e-15, atol=0)

@@ -39,9 +39,9 @@ def read(path: Path, options: ReadOptions) -> Log:
 
 
 def recognises(path: Path, head: str) -> bool:
-    """A header with ``tsec``, ``tnsec``, ``mp1`` and ``mt1``."""
+    """A header with ``tsec``, ``tnsec`` and ``mp1`` (a missing ``mt`` is then named)."""
     names = set(header_fields(head))
-    return {"tsec", "tnsec", "mp1", "mt1"} <= names
+    return {"tsec", "tnsec", "mp1"} <= names
 
 
 FORMAT = LogFormat(NAME, (".csv",), recognises, read)
