@@ -34,17 +34,27 @@ def test_name_list_lists_few_names_whole_and_many_by_their_ends() -> None:
     assert text == "n0, n1, n2, n3, n4, n5, n6, n7, n8, ..., n98, n99 (100 in all)"
 
 
-def test_a_space_separated_rtde_file_gets_a_short_error_that_says_why(tmp_path: Path) -> None:
+def test_a_space_separated_rtde_file_is_read_and_a_wide_foreign_one_gets_a_short_error(
+    tmp_path: Path,
+) -> None:
+    # Issue 22 asked for a short error on this file; issue 20 reads it (the UR RTDE reader).
     path = tmp_path / "robot_data.csv"
     rows = [
         " ".join(f"{0.002 * k + 0.1 * c:.6f}" for c in range(len(RTDE_FIELDS))) for k in range(5)
     ]
     path.write_text(" ".join(RTDE_FIELDS) + "\n" + "\n".join(rows) + "\n", encoding="utf-8")
-    with pytest.raises(ValueError, match="separated by blanks") as error:
+    log = dynid.load_log(path)
+    assert (log.format, log.n, log.T) == ("UR RTDE CSV", 6, 5)
+    # A blank-separated file of 80+ names that no reader knows: the error stays short.
+    names = ["stamp"] + [f"{s}_{j}" for s in ("pos", "vel", "eff") for j in range(30)]
+    path = tmp_path / "foreign.csv"
+    rows = [" ".join(f"{0.002 * k + c:.6f}" for c in range(len(names))) for k in range(5)]
+    path.write_text(" ".join(names) + "\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    with pytest.raises(ValueError, match=r"missing column 't'; found columns: stamp, pos_0") as e:
         dynid.load_log(path)
-    message = str(error.value)
+    message = str(e.value)
     assert len(message) < 400
-    assert f"{len(RTDE_FIELDS)} names" in message and "comma-separated" in message
+    assert f"({len(names)} in all)" in message
 
 
 def test_a_wide_log_missing_torques_names_its_columns_briefly(tmp_path: Path) -> None:

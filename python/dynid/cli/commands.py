@@ -25,20 +25,33 @@ def log_options(args: argparse.Namespace, joint_names: Any = None) -> dict[str, 
     from ..logs.columns import parse_columns
 
     columns = parse_columns(args.columns) if args.columns is not None else None
-    options = {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
-    return {**options, **ros_bag_options(args, joint_names)}
+    return {
+        "skip": args.skip,
+        "columns": columns,
+        "time_unit": args.time_unit,
+        # motor currents as tau (UR RTDE's actual_current_i; a ROS bag's effort)
+        "current": getattr(args, "current", False),
+        "drop_nonfinite": args.drop_nonfinite,
+        **ros_bag_options(args, joint_names),
+    }
 
 
 def ros_bag_options(args: argparse.Namespace, joint_names: Any) -> dict[str, Any]:
-    """``load_log``'s options for ROS bags (docs/data.md, "ROS bags"): --topic, the model's
-    joint names, --current (the effort is motor current)."""
-    options: dict[str, Any] = {
-        "joint_names": joint_names,
-        "current": getattr(args, "current", False),
-    }
+    """``load_log``'s options for ROS bags (docs/data.md, "ROS bags"): --topic and the model's
+    joint names (the message's joints are matched to them)."""
+    options: dict[str, Any] = {"joint_names": joint_names}
     if args.topic is not None:
         options["topic"] = args.topic
     return options
+
+
+def log_reading(log: Any) -> str:
+    """The log's format and what reading it did (rows dropped, time unit converted): the notes
+    after its load note, for the command's output."""
+    loaded = [i for i, note in enumerate(log.notes) if note.startswith("loaded from ")]
+    after = log.notes[loaded[-1] + 1 :] if loaded else []
+    done = [note for note in after if not note.startswith("skipped the first")]
+    return f"{log.format or 'unknown format'}" + (f"; {'; '.join(done)}" if done else "")
 
 
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -87,8 +100,8 @@ def identify(args: argparse.Namespace) -> None:
     robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
     log = load_log(args.log, **log_options(args, robot.joint_names))
     step(
-        f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
-        + (f" (first {args.skip} skipped)" if args.skip else "")
+        f"log {args.log} ({log_reading(log)}): {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, "
+        f"{log.duration:.4g} s" + (f" (first {args.skip} skipped)" if args.skip else "")
     )
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
     result = identify_log(
@@ -142,7 +155,10 @@ def identify_from_currents(args: argparse.Namespace) -> None:
     robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
     log = load_log(args.log, **log_options(args, robot.joint_names))
     loaded = load_log(args.payload_log, **log_options(args, robot.joint_names))
-    step(f"logs {args.log} ({log.T} samples), {args.payload_log} ({loaded.T} samples, loaded)")
+    step(
+        f"logs {args.log} ({log_reading(log)}; {log.T} samples), {args.payload_log} "
+        f"({log_reading(loaded)}; {loaded.T} samples, loaded)"
+    )
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
     gains = identify_drive_gains(
         robot,
@@ -193,7 +209,7 @@ def validate(args: argparse.Namespace) -> None:
     validation = run_validation(result, log, preparation=preparation_options(args))
     step(
         f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
-        f"log {args.log}: {validation.log.T} samples"
+        f"log {args.log} ({log_reading(log)}): {validation.log.T} samples"
     )
     for note in validation.notes:
         print(f"note: {note} (--cutoff)", flush=True)

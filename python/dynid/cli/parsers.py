@@ -263,7 +263,8 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
         "--columns",
         metavar="MAP",
         help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
-        "(glob patterns, joints in natural order; docs/data.md)",
+        "('*' any characters, brackets literal, joints in natural order), or by 0-based index "
+        "in a CSV without a header, 't=0,q=1:8,tau=15:22' (docs/data.md)",
     )
     p.add_argument(
         "--time-unit",
@@ -277,6 +278,12 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
         metavar="TOPIC",
         help="ROS bag: the sensor_msgs/JointState topic to read (default: the bag's only one); "
         "its joints are matched by name to the model's joint names (docs/data.md)",
+    )
+    p.add_argument(
+        "--drop-nonfinite",
+        action="store_true",
+        help="drop the log's rows holding a NaN or inf (counted in the output) instead of "
+        "refusing the file",
     )
 
 

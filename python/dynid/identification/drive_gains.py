@@ -340,6 +340,7 @@ def identify_drive_gains(
     ]
     result.training = {
         "source": first.source,
+        "format": first.format,
         "samples": sum(log.T for loaded_run, log in runs if not loaded_run),
         "duration_s": first.duration,
         "sampling_rate_hz": first.fs,

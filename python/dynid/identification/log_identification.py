@@ -453,6 +453,7 @@ def identify_log(
     )
     result.training = {
         "source": prepared.source,
+        "format": prepared.format,
         "samples": prepared.T,
         "duration_s": prepared.duration,
         "sampling_rate_hz": prepared.fs,

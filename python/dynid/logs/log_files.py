@@ -1,19 +1,18 @@
-"""Logs in and out: the checked measurement log, and loading and saving it as NPZ or CSV.
+"""Logs in and out: the checked measurement log, loading it in any registered format, and
+saving it as NPZ or CSV.
 
 A :class:`Log` holds time, joint positions and joint torques, with velocities and accelerations
-when the recording has them. Files are NPZ or CSV, laid out as in ``docs/data.md``; the
-FloBaRoID key names of the real KUKA LWR4+ recordings (``times``, ``positions``, ...) are read as
-they are. Preparing a log for identification (filtering, differentiation, decimation, dropping
-samples) is :mod:`dynid.logs.preparation`.
+when the recording has them. ``load_log`` finds the file's format in the registry
+(:mod:`dynid.logs.formats`; the readers, one per format, are in :mod:`dynid.logs.readers`) and
+adds what every format shares: ``skip`` and the plausibility of the time base. ``save_log``
+writes dynid's NPZ and CSV (``docs/data.md``). Preparing a log for identification (filtering,
+differentiation, decimation, dropping samples) is :mod:`dynid.logs.preparation`.
 """
 
 from __future__ import annotations
 
-import csv
-import re
 import warnings
-import zipfile
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
@@ -24,21 +23,12 @@ from numpy.typing import ArrayLike, NDArray
 from .._checks import count, is_integer, real_array
 from .._equality import ValueEquality
 from . import signal as sig
-from .columns import check_columns, matching, time_scale
-from .messages import name_list, quote
+from .columns import check_columns, time_scale
 
 #: A time step larger than this many median steps is a gap: filters and decimation assume a
 #: uniform grid, which a log with samples removed no longer is.
 GAP_FACTOR = 2.5
 
-#: NPZ keys: the dynid name first, then the FloBaRoID name (measurements_*.npz of kjyv/FloBaRoID).
-NPZ_KEYS = {
-    "t": ("t", "times"),
-    "q": ("q", "positions"),
-    "qd": ("qd", "velocities"),
-    "qdd": ("qdd", "accelerations"),
-    "tau": ("tau", "torques"),
-}
 SIGNALS = ("q", "tau", "qd", "qdd")  # the (T, n) arrays of a Log
 
 PathLike = Union[str, Path]
@@ -62,6 +52,7 @@ class Log(ValueEquality):
     qdd: NDArray[np.float64] | None = None
     source: str = ""
     notes: list[str] = field(default_factory=list)
+    format: str = ""  #: the recorded format's name (dynid.logs.formats), e.g. "UR RTDE CSV"
 
     def __post_init__(self) -> None:
         self.t = _float_array(self.t, "t")
@@ -95,7 +86,7 @@ class Log(ValueEquality):
         for name in ("t", *SIGNALS):
             value = getattr(self, name)
             if value is not None:
-                _check_finite(value, name)
+                check_finite(value, name)
         sig.check_time(self.t)
         self.notes = list(self.notes)
 
@@ -140,7 +131,7 @@ class Log(ValueEquality):
         values = {name: getattr(self, name) for name in ("t", *SIGNALS)}
         values.update(arrays)
         notes = self.notes + ([note] if note else [])
-        return Log(**values, source=self.source, notes=notes)
+        return Log(**values, source=self.source, notes=notes, format=self.format)
 
     def select(self, mask: ArrayLike, *, note: str | None = None) -> Log:
         """The samples where the boolean ``mask`` (T,) is True (or at the given sorted indices).
@@ -201,11 +192,13 @@ class Log(ValueEquality):
 
 
 def _float_array(value: Any, name: str) -> NDArray[np.float64]:
-    # Non-finite values are reported by _check_finite, with the row (and CSV line) they are on.
+    # Non-finite values are reported by check_finite, with the row (and CSV line) they are on.
     return np.ascontiguousarray(real_array(value, name, finite=False))
 
 
-def _check_finite(arr: NDArray, name: str, rows: NDArray | None = None) -> None:
+def check_finite(arr: NDArray, name: str, rows: NDArray | None = None) -> None:
+    """Raise naming the first row (with ``rows``: its line in the file) and joint(s) holding a NaN
+    or inf."""
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.nonzero(bad.reshape(len(arr), -1).any(axis=1))[0][0])
@@ -226,57 +219,60 @@ def load_log(
     skip: int = 0,
     columns: Mapping[str, str] | None = None,
     time_unit: str | None = None,
+    current: bool = False,
+    drop_nonfinite: bool = False,
     topic: str | None = None,
     joint_names: Sequence[str] | None = None,
-    current: bool = False,
 ) -> Log:
-    """Load a log from an ``.npz`` or ``.csv`` file or a ROS bag (formats in ``docs/data.md``).
+    """Load a log in any registered format (``dynid.logs.formats``; docs/data.md): dynid's NPZ
+    and CSV, UR RTDE, libfranka, pyfri/FRI, any CSV, MATLAB. The format is chosen by the suffix
+    and the file's header and named in ``Log.format``.
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
     the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
-    (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.logs.columns`) and
-    ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads seconds.
-    Errors name the file and what is missing or malformed. A sampling rate no robot log has
-    (outside PLAUSIBLE_RATE: nanosecond stamps read as seconds give 2e-7 Hz and a meaningless
-    fit) is an error, unless ``time_unit`` was given (then a warning: the caller said what the
-    stamps count); a position range no robot has is a warning.
-
-    A ROS bag (a ``.bag``, ``.mcap`` or ``.db3`` file, or a ROS 2 bag directory) is read by
-    :func:`dynid.logs.ros_bags.read_ros_bag` with ``topic``, ``joint_names`` (the model's: its
-    joints are matched by name) and ``current`` (the effort is motor current); other files
-    ignore ``joint_names`` and ``current``.
+    (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.logs.columns`; a CSV
+    without a header by column index, ``{"t": "0", "q": "1:8", "tau": "15:22"}``) and
+    ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads the
+    format's own unit (seconds, libfranka milliseconds). ``current`` reads motor currents as tau
+    where the format records them (UR RTDE ``actual_current_i``). ``drop_nonfinite`` drops rows
+    holding a NaN or inf (counted in the notes) instead of refusing the file. ``topic`` and
+    ``joint_names`` are for ROS bags (the topic, and the model's joint names the message's joints
+    are matched to). Errors name the file and what is missing or malformed. A sampling rate no
+    robot log has (outside PLAUSIBLE_RATE: nanosecond stamps read as seconds give 2e-7 Hz and a
+    meaningless fit) is an error, unless ``time_unit`` was given (then a warning: the caller
+    said what the stamps count); a position range no robot has is a warning.
     """
-    path = Path(path)
-    bag = path.is_dir() or path.suffix.lower() in (".bag", ".mcap", ".db3")  # logs/ros_bags.py
-    if not bag and not path.is_file():
-        raise FileNotFoundError(f"path: no such file: {path}")
-    suffix = path.suffix.lower()
-    if not bag and suffix not in (".npz", ".csv"):
-        raise ValueError(
-            f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv, or a "
-            "ROS bag (.bag, .mcap, .db3, a ROS 2 bag directory)"
-        )
-    if bag and (columns is not None or time_unit is not None):
-        raise ValueError(
-            "columns, time_unit: not for a ROS bag (joints are matched by name, time is read from "
-            "the header stamps)"
-        )
-    if not bag and topic is not None:
-        raise ValueError(f"topic: only for ROS bags, not {path.name}")
-    skip = count(skip, "skip", 0)
-    mapping = check_columns(columns) if columns is not None else None
-    seconds = time_scale("s" if time_unit is None else time_unit)
-    try:
-        if bag:
-            from .ros_bags import read_ros_bag  # rosbags (an optional extra) on first use
+    from .formats import ReadOptions, detect
 
-            log = read_ros_bag(path, topic=topic, joint_names=joint_names, current=current)
-        else:
-            log = _load_npz(path, mapping) if suffix == ".npz" else _load_csv(path, mapping)
+    path = Path(path)
+    if not path.exists():  # a folder is a log too where a format reads one (ROS 2 bags)
+        raise FileNotFoundError(f"path: no such file: {path}")
+    skip = count(skip, "skip", 0)
+    if time_unit is not None:
+        time_scale(time_unit)  # checked before the file is read
+    if topic is not None and (not isinstance(topic, str) or not topic):
+        raise ValueError(f"topic: expected a topic name, got {topic!r}")
+    if joint_names is not None:
+        if isinstance(joint_names, str) or not all(
+            isinstance(name, str) and name for name in joint_names
+        ):
+            raise ValueError(f"joint_names: expected a sequence of names, got {joint_names!r}")
+        joint_names = tuple(joint_names)
+    options = ReadOptions(
+        columns=check_columns(columns) if columns is not None else None,
+        time_unit=time_unit,
+        current=bool(current),
+        topic=topic,
+        joint_names=joint_names,
+        drop_nonfinite=bool(drop_nonfinite),
+    )
+    fmt = detect(path)
+    if topic is not None and not fmt.topics:
+        raise ValueError(f"topic: only for ROS bags, not {path.name} ({fmt.name})")
+    try:
+        log = fmt.read(path, options)
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
-    if seconds != 1.0:
-        log = log.replace(t=log.t * seconds, note=f"time stamps in {time_unit}, converted to s")
     if skip:
         if skip > log.T - 2:
             raise ValueError(f"skip: {skip} leaves fewer than 2 of the {log.T} samples of {path}")
@@ -321,227 +317,6 @@ def check_plausible(log: Log, what: str, *, unit_given: bool) -> None:
         )
 
 
-def _mapped_arrays(
-    names: Sequence[str], get: Callable[[str], NDArray], mapping: Mapping[str, str]
-) -> dict[str, NDArray]:
-    """The signals named by ``mapping`` (columns/keys or glob patterns, :mod:`.columns`): one
-    2-D array, or several 1-D ones stacked as joints in natural order; ``t`` is one 1-D array."""
-    for required in ("q", "tau"):
-        if required not in mapping:
-            raise ValueError(f"columns: {required!r} missing from the mapping {dict(mapping)}")
-    spec = {"t": "t" if "t" in names else "times", **mapping}
-    arrays: dict[str, NDArray] = {}
-    for signal, pattern in spec.items():
-        found = matching(pattern, names, signal)
-        parts = [np.asarray(get(name)) for name in found]
-        if len(parts) == 1 and (signal == "t" or parts[0].ndim == 2):
-            arrays[signal] = parts[0]
-        elif signal != "t" and all(part.ndim == 1 for part in parts):
-            arrays[signal] = np.column_stack(parts)
-        else:
-            expected = (
-                "one time vector"
-                if signal == "t"
-                else "one (T, n) array or 1-D columns, one per joint"
-            )
-            raise ValueError(
-                f"columns: {pattern!r} for {signal} matches {name_list(found)}; expected {expected}"
-            )
-    return arrays
-
-
-def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
-    try:
-        data = np.load(path, allow_pickle=False)
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # all: "not an npz"
-        raise ValueError(f"not a readable NPZ file ({type(exc).__name__}: {exc})") from None
-    with data:
-        found = list(data.files)
-        _check_npz_members(path)
-        arrays: dict[str, Any]
-        if mapping is not None:
-            arrays = _mapped_arrays(found, data.__getitem__, mapping)
-            note = f"loaded from {path.name} (NPZ, columns {dict(mapping)})"
-            return Log(**arrays, source=str(path), notes=[note])
-        arrays = {}
-        flobaroid = False
-        for name, aliases in NPZ_KEYS.items():
-            present = [key for key in aliases if key in found]
-            if len(present) > 1:
-                raise ValueError(f"both keys {present[0]!r} and {present[1]!r} given for {name}")
-            if present:
-                try:
-                    arrays[name] = data[present[0]]
-                except ValueError as exc:  # object arrays need pickle, refused on purpose
-                    raise ValueError(f"key {present[0]!r}: unreadable ({exc})") from None
-                flobaroid |= present[0] != name
-        notes = [str(s) for s in data["notes"]] if "notes" in found else []
-    for name in ("t", "q", "tau"):
-        if name not in arrays:
-            alias = NPZ_KEYS[name][1]
-            raise ValueError(
-                f"missing key {name!r} (or FloBaRoID {alias!r}); found keys: {name_list(found)}"
-            )
-    for name, arr in arrays.items():
-        if arr.dtype.kind not in "iuf":
-            raise ValueError(f"key for {name}: expected numbers, got dtype {arr.dtype}")
-    how = "FloBaRoID key names" if flobaroid else "dynid key names"
-    note = f"loaded from {path.name} (NPZ, {how}; {', '.join(arrays)})"
-    return Log(**arrays, source=str(path), notes=[*notes, note])
-
-
-def _check_npz_members(path: Path) -> None:
-    """Refuse a member whose .npy header asks for more bytes than the member holds (a corrupt or
-    hostile header would otherwise make NumPy try to allocate it) or that is not .npy at all."""
-    with zipfile.ZipFile(path) as archive:
-        for info in archive.infolist():
-            if not info.filename.endswith(".npy"):
-                raise ValueError(f"member {info.filename!r} is not a .npy array")
-            with archive.open(info) as member:
-                try:
-                    version = np.lib.format.read_magic(member)
-                    read = (
-                        np.lib.format.read_array_header_1_0
-                        if version == (1, 0)
-                        else np.lib.format.read_array_header_2_0
-                    )
-                    shape, _, dtype = read(member)
-                except (ValueError, OSError, EOFError) as exc:
-                    raise ValueError(
-                        f"member {info.filename!r}: unreadable header ({exc})"
-                    ) from None
-            needed = dtype.itemsize * int(np.prod(shape, dtype=object))
-            if needed > info.file_size:
-                raise ValueError(
-                    f"member {info.filename!r}: its header asks for shape {shape} "
-                    f"({needed} bytes) but the member holds {info.file_size} bytes"
-                )
-
-
-_CSV_COLUMN = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
-
-
-def _check_comma_separated(header: list[str], line: int) -> None:
-    """Refuse a header that is one column of names separated by blanks (a UR RTDE recording,
-    a MATLAB or spreadsheet export with another delimiter): dynid's CSV logs are comma-separated
-    (docs/data.md)."""
-    if len(header) != 1:
-        return
-    names = header[0].split()
-    if len(names) > 1:
-        raise ValueError(
-            f"line {line}: the header is one column of {len(names)} names separated by blanks "
-            f"({name_list(names)}); CSV logs are comma-separated (docs/data.md)"
-        )
-
-
-def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str]]:
-    """(header, values, line number of each data row, notes) of a CSV log."""
-    header: list[str] | None = None
-    header_line = 0
-    notes: list[str] = []
-    data: list[str] = []
-    lines: list[int] = []
-    with path.open(newline="") as handle:
-        for number, line in enumerate(handle, start=1):
-            text = line.strip()
-            if text.startswith("# note:"):
-                notes.append(text[len("# note:") :].strip())
-            if not text or text.startswith("#"):
-                continue
-            if header is None:
-                header = [f.strip() for f in next(csv.reader([text]))]
-                header_line = number
-                _check_comma_separated(header, header_line)
-            else:
-                data.append(text)
-                lines.append(number)
-    if header is None:
-        raise ValueError("no header row (expected columns t, q1..qn, tau1..taun)")
-    duplicates = sorted({c for c in header if header.count(c) > 1})
-    if duplicates:
-        raise ValueError(f"duplicate columns in the header: {', '.join(duplicates)}")
-    try:  # fast path (C parser); on failure the loop below finds and names the bad line
-        values = np.loadtxt(data, delimiter=",", ndmin=2, dtype=float) if data else None
-        if values is not None and values.shape == (len(data), len(header)):
-            return header, values, lines, notes
-    except ValueError:
-        pass
-    values = np.empty((len(data), len(header)))
-    for r, text in enumerate(data):
-        fields = [f.strip() for f in next(csv.reader([text]))]
-        if len(fields) != len(header):
-            raise ValueError(
-                f"line {lines[r]}: {len(fields)} fields, but the header (line {header_line}) "
-                f"has {len(header)} columns"
-            )
-        for c, field_text in enumerate(fields):
-            try:
-                values[r, c] = float(field_text)
-            except ValueError:
-                raise ValueError(
-                    f"line {lines[r]}, column {quote(header[c])}: "
-                    f"cannot read {quote(field_text)} as a number"
-                ) from None
-    return header, values, lines, notes
-
-
-def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
-    header, values, lines, notes = _read_csv_table(path)
-    index = {name: c for c, name in enumerate(header)}
-    arrays: dict[str, Any]
-    if mapping is not None:
-        arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping)
-        note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
-        return Log(**arrays, source=str(path), notes=[*notes, note])
-    if "t" not in index:
-        raise ValueError(f"missing column 't'; found columns: {name_list(header)}")
-    groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
-    for name, c in index.items():
-        match = _CSV_COLUMN.match(name)
-        if match:
-            groups[match.group(1)][int(match.group(2))] = c
-    if not groups["q"]:
-        raise ValueError(f"missing columns q1..qn; found columns: {name_list(header)}")
-    n = max(groups["q"])
-    arrays = {"t": values[:, index["t"]]}
-    for name, columns in groups.items():
-        if not columns:
-            if name == "tau":
-                raise ValueError(
-                    f"missing columns tau1..tau{n}; found columns: {name_list(header)}"
-                )
-            continue
-        wanted = range(1, n + 1)
-        missing = [f"{name}{j}" for j in wanted if j not in columns]
-        extra = [f"{name}{j}" for j in sorted(columns) if j not in wanted]
-        if missing or extra:
-            problem = f"missing {', '.join(missing)}" if missing else f"extra {', '.join(extra)}"
-            raise ValueError(
-                f"inconsistent joint columns: expected {name}1..{name}{n} (n = {n} from column "
-                f"q{n}), {problem}; found columns: {name_list(header)}"
-            )
-        arrays[name] = values[:, [columns[j] for j in wanted]]
-    line_numbers = np.asarray(lines)
-    for name, arr in arrays.items():
-        _check_finite(arr, name, rows=line_numbers)
-    if len(lines) < 2:
-        raise ValueError(f"expected at least 2 data rows, got {len(lines)}")
-    backwards = np.nonzero(np.diff(arrays["t"]) <= 0)[0]
-    if backwards.size:
-        i = int(backwards[0]) + 1
-        raise ValueError(
-            f"t: not strictly increasing at line {lines[i]} (data row {i}): "
-            f"t = {float(arrays['t'][i])!r} after {float(arrays['t'][i - 1])!r} on line "
-            f"{lines[i - 1]}"
-        )
-    ignored = [c for c in header if c != "t" and not _CSV_COLUMN.match(c)]
-    note = f"loaded from {path.name} (CSV, {', '.join(arrays)})"
-    if ignored:
-        note += f"; ignored columns {', '.join(ignored)}"
-    return Log(**arrays, source=str(path), notes=[*notes, note])
-
-
 # --------------------------------------------------------------------------- saving
 
 
@@ -549,8 +324,8 @@ def save_log(log: Log, path: PathLike) -> None:
     """Write a log as ``.npz`` (keys t, q, tau[, qd, qdd], notes) or ``.csv`` (docs/data.md).
 
     Values are written exactly (NPZ binary, CSV with 17 significant digits), so loading the
-    file gives back the same arrays. The notes go into the file (a string array in NPZ,
-    ``# note:`` lines in CSV) and come back on loading.
+    file gives back the same arrays. The notes and the format go into the file (string arrays
+    in NPZ, ``# note:`` and ``# format:`` lines in CSV) and come back on loading.
     """
     if not isinstance(log, Log):
         raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
@@ -560,12 +335,15 @@ def save_log(log: Log, path: PathLike) -> None:
     if suffix == ".npz":
         arrays = {name: getattr(log, name) for name in ("t", *present)}
         with path.open("wb") as handle:  # a handle: np.savez would append ".npz" to "x.NPZ"
+            if log.format:
+                arrays["format"] = np.asarray(log.format)
             np.savez(handle, **arrays, notes=np.asarray(log.notes, dtype=str))
     elif suffix == ".csv":
         order = [name for name in ("q", "qd", "qdd", "tau") if name in present]
         header = ["t"] + [f"{name}{j}" for name in order for j in range(1, log.n + 1)]
         table = np.column_stack([log.t] + [getattr(log, name) for name in order])
         comments = ["# dynid log: t in s, q in rad or m, tau in N*m or N (docs/data.md)"]
+        comments += [f"# format: {log.format}"] if log.format else []
         comments += [f"# note: {note}" for note in log.notes]
         with path.open("w", newline="") as handle:
             handle.write("\n".join(comments) + "\n" + ",".join(header) + "\n")

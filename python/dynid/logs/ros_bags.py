@@ -35,6 +35,10 @@ BAG_SUFFIXES = (".bag", ".mcap", ".db3")
 EXTRA = 'pip install "dynid[ros]"'
 
 
+#: The format's name in the output and result.json (dynid.logs.readers.ros_bag).
+FORMAT_NAME = "ROS bag"
+
+
 def is_ros_bag(path: str | Path) -> bool:
     """Whether ``path`` is read as a ROS bag: a directory or a .bag/.mcap/.db3 file."""
     path = Path(path)
@@ -201,6 +205,7 @@ def _joint_states(
         tau=tau[order_by_stamp],
         qd=qd[order_by_stamp] if velocity_everywhere else None,
         source=str(path),
+        format=FORMAT_NAME,
         notes=[note],
     )
 
