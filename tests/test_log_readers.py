@@ -271,13 +271,15 @@ def test_specific_formats_come_before_the_generic_ones():
 def test_unknown_extension_lists_the_readable_ones(tmp_path: Path):
     path = tmp_path / "log.xlsx"
     path.write_text("x")
-    with pytest.raises(ValueError, match=re.escape("expected .npz or .csv, or .mat")):
+    with pytest.raises(ValueError, match=re.escape("expected .npz or .csv, or ")) as raised:
         load_log(path)
+    assert ".mat" in str(raised.value) and ".bag, .mcap, .db3" in str(raised.value)
 
 
-def test_a_folder_is_refused_unless_a_format_reads_folders(tmp_path: Path):
-    with pytest.raises(ValueError, match="is a folder; no log format reads a folder"):
-        load_log(tmp_path)
+def test_a_folder_is_read_as_a_ros2_bag(tmp_path: Path):
+    # The ROS bag format reads folders (a ROS 2 bag is one); any other folder is no bag.
+    with pytest.raises(ValueError, match=r"without metadata\.yaml"):
+        load_log(tmp_path, joint_names=["q1"])
 
 
 @pytest.mark.parametrize(
