@@ -24,7 +24,24 @@ def log_options(args: argparse.Namespace) -> dict[str, Any]:
     from ..logs.columns import parse_columns
 
     columns = parse_columns(args.columns) if args.columns is not None else None
-    return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+    return {
+        "skip": args.skip,
+        "columns": columns,
+        "time_unit": args.time_unit,
+        "sample_time": args.sample_time,
+    }
+
+
+def to_joint_side(args: argparse.Namespace, log: Any, robot: Any) -> Any:
+    """With ``--motor-side``, ``log`` mapped to the joints through ``robot``'s gear ratios,
+    transmission and joint offsets (dynid.logs.motor_side); otherwise ``log`` as it is."""
+    if not getattr(args, "motor_side", False):
+        return log
+    from ..logs.motor_side import motor_to_joint
+
+    joint_log = motor_to_joint(log, robot)
+    print(f"note: {joint_log.notes[-1]}", flush=True)
+    return joint_log
 
 
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -58,6 +75,8 @@ def identify(args: argparse.Namespace) -> None:
     from ..model.model_files import load_model
 
     check_output_path(args.output, args.overwrite, inputs=identify_inputs(args))  # before the work
+    if args.current and args.motor_side:
+        raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     if args.current:
         identify_from_currents(args)
         return
@@ -77,6 +96,7 @@ def identify(args: argparse.Namespace) -> None:
     )
     robot = load_model(args.model)
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
+    log = to_joint_side(args, log, robot)
     result = identify_log(
         log,
         robot,
@@ -163,8 +183,10 @@ def validate(args: argparse.Namespace) -> None:
 
     check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
     step = _steps(3)
+    if args.current and args.motor_side:
+        raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     result = load_result(args.result)
-    log = load_log(args.log, **log_options(args))
+    log = to_joint_side(args, load_log(args.log, **log_options(args)), result.robot)
     if args.current:
         from ..identification.drive_gains import torques_from_currents
 

@@ -96,6 +96,7 @@ def _add_identify(subcommands: Any) -> None:
     )
     _add_current(p)
     _add_preparation(p)
+    _add_motor_side(p)
     p.add_argument(
         "--min-velocity",
         type=float,
@@ -125,6 +126,7 @@ def _add_validate(subcommands: Any) -> None:
         "(a result of `dynid identify --current`)",
     )
     _add_preparation(p)
+    _add_motor_side(p)
     _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
 
@@ -257,6 +259,24 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
         default=None,
         help="unit of the log's time stamps (default: s, and a sampling rate outside 1 Hz to "
         "100 kHz is an error; with the unit given, a warning)",
+    )
+    p.add_argument(
+        "--sample-time",
+        type=float,
+        metavar="DT",
+        help="sample time [s] of a log without a time vector, t = 0, DT, 2 DT, ... (an NPZ "
+        "key 'sample_time' is read without it)",
+    )
+
+
+def _add_motor_side(p: argparse.ArgumentParser) -> None:
+    """A motor-side log (commands.to_joint_side)."""
+    p.add_argument(
+        "--motor-side",
+        action="store_true",
+        help="LOG holds motor angles and motor torques: mapped to the joints through the "
+        "model's gear_ratios, transmission and joint_offsets, q = R^-1 theta - joint_offsets, "
+        "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md)",
     )
 
 

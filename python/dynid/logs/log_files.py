@@ -226,6 +226,7 @@ def load_log(
     skip: int = 0,
     columns: Mapping[str, str] | None = None,
     time_unit: str | None = None,
+    sample_time: float | None = None,
 ) -> Log:
     """Load a log from an ``.npz`` or ``.csv`` file (formats in ``docs/data.md``).
 
@@ -233,6 +234,8 @@ def load_log(
     the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
     (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.logs.columns`) and
     ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads seconds.
+    A log without a time vector (a motor-side recording such as the Staubli TX40's) needs
+    ``sample_time`` [s], or an NPZ key ``sample_time``: t = 0, dt, 2 dt, ...
     Errors name the file and what is missing or malformed. A sampling rate no robot log has
     (outside PLAUSIBLE_RATE: nanosecond stamps read as seconds give 2e-7 Hz and a meaningless
     fit) is an error, unless ``time_unit`` was given (then a warning: the caller said what the
@@ -249,8 +252,13 @@ def load_log(
     skip = count(skip, "skip", 0)
     mapping = check_columns(columns) if columns is not None else None
     seconds = time_scale("s" if time_unit is None else time_unit)
+    if sample_time is not None:
+        sample_time = _check_sample_time(sample_time, "sample_time")
     try:
-        log = _load_npz(path, mapping) if suffix == ".npz" else _load_csv(path, mapping)
+        if suffix == ".npz":
+            log = _load_npz(path, mapping, sample_time)
+        else:
+            log = _load_csv(path, mapping, sample_time)
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
     if seconds != 1.0:
@@ -299,15 +307,44 @@ def check_plausible(log: Log, what: str, *, unit_given: bool) -> None:
         )
 
 
+def _check_sample_time(value: Any, name: str) -> float:
+    """A sample time in seconds: one finite number > 0."""
+    try:
+        dt = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number of seconds, got {value!r}") from None
+    if not np.isfinite(dt) or dt <= 0.0:
+        raise ValueError(f"{name}: expected a finite sample time > 0 s, got {value!r}")
+    return dt
+
+
+def _time_vector(samples: int, sample_time: float | None, found: str) -> NDArray[np.float64]:
+    """t = 0, dt, 2 dt, ... for a log without a time vector; without ``sample_time`` an error
+    that says how to give it."""
+    if sample_time is None:
+        raise ValueError(
+            f"no time vector (key or column 't' or 'times'; found {found}): give the sample "
+            "time with sample_time / --sample-time, or an NPZ key 'sample_time'"
+        )
+    return np.arange(samples, dtype=float) * sample_time
+
+
 def _mapped_arrays(
-    names: Sequence[str], get: Callable[[str], NDArray], mapping: Mapping[str, str]
+    names: Sequence[str],
+    get: Callable[[str], NDArray],
+    mapping: Mapping[str, str],
+    sample_time: float | None = None,
 ) -> dict[str, NDArray]:
     """The signals named by ``mapping`` (columns/keys or glob patterns, :mod:`.columns`): one
-    2-D array, or several 1-D ones stacked as joints in natural order; ``t`` is one 1-D array."""
+    2-D array, or several 1-D ones stacked as joints in natural order; ``t`` is one 1-D array,
+    or 0, dt, 2 dt, ... when the log has none and ``sample_time`` is given."""
     for required in ("q", "tau"):
         if required not in mapping:
             raise ValueError(f"columns: {required!r} missing from the mapping {dict(mapping)}")
-    spec = {"t": "t" if "t" in names else "times", **mapping}
+    timeless = "t" not in mapping and "t" not in names and "times" not in names
+    if not timeless and sample_time is not None and "sample_time" not in names:
+        raise ValueError("sample_time: given, but the log has a time vector; give one of them")
+    spec = {**({} if timeless else {"t": "t" if "t" in names else "times"}), **mapping}
     arrays: dict[str, NDArray] = {}
     for signal, pattern in spec.items():
         found = matching(pattern, names, signal)
@@ -325,10 +362,14 @@ def _mapped_arrays(
             raise ValueError(
                 f"columns: {pattern!r} for {signal} matches {name_list(found)}; expected {expected}"
             )
+    if timeless:
+        arrays["t"] = _time_vector(len(arrays["q"]), sample_time, name_list(names))
     return arrays
 
 
-def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
+def _load_npz(
+    path: Path, mapping: Mapping[str, str] | None = None, sample_time: float | None = None
+) -> Log:
     try:
         data = np.load(path, allow_pickle=False)
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # all: "not an npz"
@@ -336,9 +377,11 @@ def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     with data:
         found = list(data.files)
         _check_npz_members(path)
+        if sample_time is None and "sample_time" in found:
+            sample_time = _check_sample_time(data["sample_time"], "key 'sample_time'")
         arrays: dict[str, Any]
         if mapping is not None:
-            arrays = _mapped_arrays(found, data.__getitem__, mapping)
+            arrays = _mapped_arrays(found, data.__getitem__, mapping, sample_time)
             note = f"loaded from {path.name} (NPZ, columns {dict(mapping)})"
             return Log(**arrays, source=str(path), notes=[note])
         arrays = {}
@@ -354,6 +397,11 @@ def _load_npz(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
                     raise ValueError(f"key {present[0]!r}: unreadable ({exc})") from None
                 flobaroid |= present[0] != name
         notes = [str(s) for s in data["notes"]] if "notes" in found else []
+    if "t" not in arrays and "q" in arrays:
+        arrays["t"] = _time_vector(len(arrays["q"]), sample_time, name_list(found))
+        notes.append(f"no time vector: t = 0, {sample_time:g} s, ... (sample time)")
+    elif sample_time is not None and "sample_time" not in found:
+        raise ValueError("sample_time: given, but the log has a time vector; give one of them")
     for name in ("t", "q", "tau"):
         if name not in arrays:
             alias = NPZ_KEYS[name][1]
@@ -464,16 +512,20 @@ def _read_csv_table(path: Path) -> tuple[list[str], NDArray, list[int], list[str
     return header, values, lines, notes
 
 
-def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
+def _load_csv(
+    path: Path, mapping: Mapping[str, str] | None = None, sample_time: float | None = None
+) -> Log:
     header, values, lines, notes = _read_csv_table(path)
     index = {name: c for c, name in enumerate(header)}
     arrays: dict[str, Any]
     if mapping is not None:
-        arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping)
+        arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping, sample_time)
         note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
         return Log(**arrays, source=str(path), notes=[*notes, note])
-    if "t" not in index:
+    if "t" not in index and sample_time is None:
         raise ValueError(f"missing column 't'; found columns: {name_list(header)}")
+    if "t" in index and sample_time is not None:
+        raise ValueError("sample_time: given, but the log has a column 't'; give one of them")
     groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
     for name, c in index.items():
         match = _CSV_COLUMN.match(name)
@@ -482,7 +534,11 @@ def _load_csv(path: Path, mapping: Mapping[str, str] | None = None) -> Log:
     if not groups["q"]:
         raise ValueError(f"missing columns q1..qn; found columns: {name_list(header)}")
     n = max(groups["q"])
-    arrays = {"t": values[:, index["t"]]}
+    arrays = {
+        "t": values[:, index["t"]]
+        if "t" in index
+        else _time_vector(len(values), sample_time, name_list(header))
+    }
     for name, columns in groups.items():
         if not columns:
             if name == "tau":
