@@ -397,7 +397,7 @@ def _load_npz(
                     raise ValueError(f"key {present[0]!r}: unreadable ({exc})") from None
                 flobaroid |= present[0] != name
         notes = [str(s) for s in data["notes"]] if "notes" in found else []
-    if "t" not in arrays and "q" in arrays:
+    if "t" not in arrays and "q" in arrays and sample_time is not None:
         arrays["t"] = _time_vector(len(arrays["q"]), sample_time, name_list(found))
         notes.append(f"no time vector: t = 0, {sample_time:g} s, ... (sample time)")
     elif sample_time is not None and "sample_time" not in found:
@@ -405,8 +405,10 @@ def _load_npz(
     for name in ("t", "q", "tau"):
         if name not in arrays:
             alias = NPZ_KEYS[name][1]
+            hint = "; or give the sample time (sample_time / --sample-time)" if name == "t" else ""
             raise ValueError(
                 f"missing key {name!r} (or FloBaRoID {alias!r}); found keys: {name_list(found)}"
+                + hint
             )
     for name, arr in arrays.items():
         if arr.dtype.kind not in "iuf":
