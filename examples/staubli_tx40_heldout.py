@@ -45,6 +45,7 @@ MODEL = Path(__file__).resolve().parent / "staubli_tx40.json"
 COLUMNS = {"q": "motor_position", "tau": "motor_torque"}
 TRAIN, HELD_OUT, SCORED = (0, 24750), (29250, 45000), (29270, 44980)
 FACTOR = 10  # the README's decimation of the target
+REST = 1e-12  # |qd| below this is rounding noise of a constant (filtered) angle
 OPTIONS = ["--rotor", "--friction", "--offset", "--cutoff", "100", "--decimate", "10"]
 
 
@@ -102,9 +103,18 @@ def run(
     if dynid_main(argv) != 0:
         raise SystemExit("staubli_tx40_heldout: dynid identify failed")
     result = load_result(output)
-    held_out = dynid.motor_to_joint(dynid.load_log(work / "heldout.npz", columns=COLUMNS), result.robot)
+    held_out = dynid.motor_to_joint(
+        dynid.load_log(work / "heldout.npz", columns=COLUMNS), result.robot
+    )
     validation = run_validation(result, held_out, preparation=result.training.get("preparation"))
     rows, predicted = scored_prediction(validation.log.t, validation.predicted, dt)
+    # Diagnostic, not dynid's model: at rest the filtered encoder angle is constant up to
+    # rounding, qd is +-1e-17 and sign(qd) picks +-Fs at random; with those qd set to 0 the
+    # Coulomb term is 0 there (docs/real_data.md, "The Staubli TX40").
+    at_rest = validation.log.replace(
+        qd=np.where(np.abs(validation.log.qd) < REST, 0.0, validation.log.qd)
+    )
+    rest_rows, rest_predicted = scored_prediction(at_rest.t, result.predict(at_rest), dt)
     measured = target(data, result.robot)
     scored = SCORED[1] // FACTOR - SCORED[0] // FACTOR
     # The same model on the held-out samples' states prepared from the whole recording (no
@@ -117,19 +127,25 @@ def run(
     whole_rows, whole_predicted = scored_prediction(shifted, again.predicted, dt)
     table = {
         "dynid": (100 * relative_rms(predicted, measured[rows])).tolist(),
+        "diagnostic: qd = 0 where |qd| < 1e-12": (
+            100 * relative_rms(rest_predicted, measured[rest_rows])
+        ).tolist(),
         "dynid, states from the whole log": (
             100 * relative_rms(whole_predicted, measured[whole_rows])
         ).tolist(),
         "dynid training": (100 * np.asarray(result.training["metrics"]["relative_rms"])).tolist(),
         "samples scored": f"{len(rows)} of {scored}",
-        "command": "dynid " + " ".join(argv[:1] + ["train.npz"] + argv[2:-3]),
+        "command": "dynid " + " ".join([*argv[:1], "train.npz", *argv[2:-3]]),
         "preparation": result.training.get("preparation"),
     }
     peer = data_dir / "figaroh_1.0.2_heldout_predictions.npz"
     if peer.is_file():
         with np.load(peer) as npz:
-            first, last = (int(v) for v in npz["rows"])
-            for key, label in (("pred_asis", "FIGAROH as shipped"), ("pred_coupled", "FIGAROH coupled")):
+            first = int(npz["rows"][0])
+            for key, label in (
+                ("pred_asis", "FIGAROH as shipped"),
+                ("pred_coupled", "FIGAROH coupled"),
+            ):
                 pred = signal.decimate(npz[key], FACTOR, axis=0, zero_phase=True)
                 ref = measured[first // FACTOR : first // FACTOR + len(pred)]
                 table[label] = (100 * relative_rms(pred, ref)).tolist()
@@ -141,7 +157,9 @@ def main() -> None:
     argv = sys.argv[1:]
     extra = argv[argv.index("--") + 1 :] if "--" in argv else []
     argv = argv[: argv.index("--")] if "--" in argv else argv
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawTextHelpFormatter
+    )
     parser.add_argument("data_dir", type=Path, help="folder holding tx40_motor_log.npz")
     parser.add_argument("--output", type=Path, default=Path("tx40-identify"))
     parser.add_argument(
@@ -151,9 +169,17 @@ def main() -> None:
     )
     args = parser.parse_args(argv)
     table = run(args.data_dir, args.output, extra, args.options.split())
-    print(f"\nheld-out relative RMS (%), samples {SCORED[0]}:{SCORED[1]} ({table['samples scored']})")
+    print(
+        f"\nheld-out relative RMS (%), samples {SCORED[0]}:{SCORED[1]} ({table['samples scored']})"
+    )
     print("| | J1 | J2 | J3 | J4 | J5 | J6 |\n|---|---|---|---|---|---|---|")
-    for label in ("FIGAROH as shipped", "FIGAROH coupled", "dynid", "dynid, states from the whole log"):
+    for label in (
+        "FIGAROH as shipped",
+        "FIGAROH coupled",
+        "dynid",
+        "dynid, states from the whole log",
+        "diagnostic: qd = 0 where |qd| < 1e-12",
+    ):
         if label in table:
             values = table[label]
             print(f"| {label} | " + " | ".join(f"{v:.3g}" for v in values) + " |")  # type: ignore[union-attr]

@@ -111,11 +111,11 @@ def test_power_is_the_same_on_both_sides() -> None:
 
 def test_bad_input_names_the_argument() -> None:
     robot = _tx40_like()
-    with pytest.raises(ValueError, match="^log: has 7 motors"):
+    with pytest.raises(ValueError, match=r"^log: has 7 motors"):
         motor_to_joint(_random_motor_log(5, n=7), robot)
-    with pytest.raises(ValueError, match="^log: expected a dynid.Log"):
+    with pytest.raises(ValueError, match=r"^log: expected a dynid.Log"):
         motor_to_joint({"q": np.zeros((3, 6))}, robot)  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="^robot: expected a dynid.Robot"):
+    with pytest.raises(ValueError, match=r"^robot: expected a dynid.Robot"):
         motor_to_joint(_random_motor_log(5), object())  # type: ignore[arg-type]
     for bad, message in (
         ([32.0, 32.0, 0.0, -48.0, 45.0, 32.0], "gear_ratios: joint 3 has a zero gear ratio"),
@@ -191,10 +191,10 @@ def test_csv_without_time_column_needs_sample_time(tmp_path) -> None:
 def test_sample_time_errors(tmp_path) -> None:
     np.savez(tmp_path / "m.npz", motor_position=np.zeros((3, 2)), motor_torque=np.zeros((3, 2)))
     columns = {"q": "motor_position", "tau": "motor_torque"}
-    with pytest.raises(ValueError, match="no time vector.*sample_time"):
+    with pytest.raises(ValueError, match=r"no time vector.*sample_time"):
         load_log(tmp_path / "m.npz", columns=columns)
     for bad in (0.0, -1e-3, np.nan, "fast"):
-        with pytest.raises(ValueError, match="^sample_time: expected"):
+        with pytest.raises(ValueError, match=r"^sample_time: expected"):
             load_log(tmp_path / "m.npz", columns=columns, sample_time=bad)  # type: ignore[arg-type]
     np.savez(tmp_path / "t.npz", t=np.arange(3.0), q=np.zeros((3, 2)), tau=np.zeros((3, 2)))
     with pytest.raises(ValueError, match="sample_time: given, but the log has a time vector"):
