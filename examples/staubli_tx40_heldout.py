@@ -1,10 +1,13 @@
 """The Staubli TX40 held-out table of docs/real_data.md ("The Staubli TX40"), reproduced.
 
 The recording (motor side, coupled wrist, 5 kHz, no time vector) is not in the repository: give
-the folder that holds ``tx40_motor_log.npz`` (and, for FIGAROH's rows,
-``figaroh_1.0.2_heldout_predictions.npz``), e.g. ``../shared/data/staubli_tx40``::
+the folder that holds ``tx40_motor_log.npz`` (FIGAROH's ``pos_read_data.csv`` and
+``curr_data.csv`` of thanhndv212/figaroh-plus@c3b51728, ``examples/staubli_TX40/data``,
+Apache-2.0, re-packed unchanged as the keys ``motor_position``, ``motor_torque`` (45000, 6) and
+``sample_time`` 2e-4) and, for FIGAROH's rows, ``figaroh_1.0.2_heldout_predictions.npz`` (its
+held-out predictions, ``pred_asis`` and ``pred_coupled``, samples 29270:44980)::
 
-    python examples/staubli_tx40_heldout.py DATA_DIR [--output DIR] [-- EXTRA IDENTIFY OPTIONS]
+    python examples/staubli_tx40_heldout.py DATA_DIR [--output DIR] [--options "..."] [-- EXTRA]
 
 What it does, as a user would:
 
