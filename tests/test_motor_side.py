@@ -172,6 +172,7 @@ def test_npz_without_time_vector_reads_its_sample_time(tmp_path) -> None:
     log = load_log(tmp_path / "m.npz", columns={"q": "motor_position", "tau": "motor_torque"})
     np.testing.assert_array_equal(log.t, [0.0, 2e-4, 4e-4])
     np.testing.assert_array_equal(log.q, theta)
+    assert "no time vector" in log.notes[-1]
     np.savez(tmp_path / "d.npz", q=theta, tau=-theta, sample_time=1e-3)  # dynid key names
     np.testing.assert_array_equal(load_log(tmp_path / "d.npz").t, [0.0, 1e-3, 2e-3])
 

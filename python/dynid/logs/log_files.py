@@ -329,6 +329,13 @@ def _time_vector(samples: int, sample_time: float | None, found: str) -> NDArray
     return np.arange(samples, dtype=float) * sample_time
 
 
+def _timeless_note(names: Sequence[str], mapping: Mapping[str, str]) -> list[str]:
+    """The note of a mapped log whose time vector was made from its sample time."""
+    if "t" in mapping or "t" in names or "times" in names:
+        return []
+    return ["no time vector: t = 0, dt, 2 dt, ... from the sample time"]
+
+
 def _mapped_arrays(
     names: Sequence[str],
     get: Callable[[str], NDArray],
@@ -383,7 +390,7 @@ def _load_npz(
         if mapping is not None:
             arrays = _mapped_arrays(found, data.__getitem__, mapping, sample_time)
             note = f"loaded from {path.name} (NPZ, columns {dict(mapping)})"
-            return Log(**arrays, source=str(path), notes=[note])
+            return Log(**arrays, source=str(path), notes=[note, *_timeless_note(found, mapping)])
         arrays = {}
         flobaroid = False
         for name, aliases in NPZ_KEYS.items():
@@ -523,7 +530,8 @@ def _load_csv(
     if mapping is not None:
         arrays = _mapped_arrays(header, lambda name: values[:, index[name]], mapping, sample_time)
         note = f"loaded from {path.name} (CSV, columns {dict(mapping)})"
-        return Log(**arrays, source=str(path), notes=[*notes, note])
+        extra = _timeless_note(header, mapping)
+        return Log(**arrays, source=str(path), notes=[*notes, note, *extra])
     if "t" not in index and sample_time is None:
         raise ValueError(f"missing column 't'; found columns: {name_list(header)}")
     if "t" in index and sample_time is not None:
