@@ -32,15 +32,31 @@ def log_options(args: argparse.Namespace) -> dict[str, Any]:
     }
 
 
+def load_log_of(args: argparse.Namespace) -> Any:
+    """``load_log(args.log, ...)``; for a motor-side log without the warning of positions beyond
+    100 rad, which motor angles (before the gear) may well exceed: ``to_joint_side`` checks the
+    joint angles instead."""
+    import warnings
+
+    from ..logs.log_files import load_log
+
+    with warnings.catch_warnings():
+        if getattr(args, "motor_side", False):
+            warnings.filterwarnings("ignore", message=r".*q: positions up to", category=UserWarning)
+        return load_log(args.log, **log_options(args))
+
+
 def to_joint_side(args: argparse.Namespace, log: Any, robot: Any) -> Any:
     """With ``--motor-side``, ``log`` mapped to the joints through ``robot``'s gear ratios,
     transmission and joint offsets (dynid.logs.motor_side); otherwise ``log`` as it is."""
     if not getattr(args, "motor_side", False):
         return log
+    from ..logs.log_files import check_plausible
     from ..logs.motor_side import motor_to_joint
 
     joint_log = motor_to_joint(log, robot)
     print(f"note: {joint_log.notes[-1]}", flush=True)
+    check_plausible(joint_log, f"{args.log} (joint side)", unit_given=True)
     return joint_log
 
 
@@ -71,7 +87,6 @@ def identify(args: argparse.Namespace) -> None:
     from ..export.output_folder import check_output_path
     from ..export.result_files import save_result
     from ..identification.log_identification import identify_log
-    from ..logs.log_files import load_log
     from ..model.model_files import load_model
 
     check_output_path(args.output, args.overwrite, inputs=identify_inputs(args))  # before the work
@@ -89,7 +104,7 @@ def identify(args: argparse.Namespace) -> None:
     if args.friction and args.asymmetric_friction:
         raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
-    log = load_log(args.log, **log_options(args))
+    log = load_log_of(args)
     step(
         f"log {args.log}: {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, {log.duration:.4g} s"
         + (f" (first {args.skip} skipped)" if args.skip else "")
@@ -179,14 +194,13 @@ def validate(args: argparse.Namespace) -> None:
     from ..export.result_files import load_result, save_validation
     from ..identification.log_identification import run_validation
     from ..identification.validation import validation_table
-    from ..logs.log_files import load_log
 
     check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
     step = _steps(3)
     if args.current and args.motor_side:
         raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     result = load_result(args.result)
-    log = to_joint_side(args, load_log(args.log, **log_options(args)), result.robot)
+    log = to_joint_side(args, load_log_of(args), result.robot)
     if args.current:
         from ..identification.drive_gains import torques_from_currents
 
