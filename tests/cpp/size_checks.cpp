@@ -204,6 +204,12 @@ int main() {
   reversed.col(0).setOnes();
   reversed.col(1).setZero();
   expect_rejected("Model", "qlim", [&] { editable.set_joint_limits(reversed); }, false);
+  expect_rejected("Model", "gear_ratios", [&] { editable.set_gear_ratios(short_vector); }, false);
+  VectorX zero_ratio = VectorX::Ones(n);
+  zero_ratio[1] = 0.0;  // R = diag(gear_ratios) T would be singular
+  expect_rejected("Model", "gear_ratios", [&] { editable.set_gear_ratios(zero_ratio); }, false);
+  expect_rejected(
+      "Model", "joint_offsets", [&] { editable.set_joint_offsets(long_vector); }, false);
   dynid::RecursiveLeastSquares rls(4);
   const MatrixX block = MatrixX::Ones(2, 4);
   expect_rejected(
