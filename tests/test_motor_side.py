@@ -281,3 +281,31 @@ def test_motor_side_errors_exit_2(tmp_path, capsys) -> None:
     assert main([*base, "--columns", "q=motor_position,tau=motor_torque",
                  "--sample-time", "-1"]) == 2  # fmt: skip
     assert "sample_time: expected a finite sample time > 0" in capsys.readouterr().err
+
+
+def test_heldout_script_scores_the_readmes_samples() -> None:
+    """examples/staubli_tx40_heldout.py compares sample 10 k of the held-out rows with row k of
+    the decimated target: at the decimated rate as they are, at 5 kHz after decimating x10."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("tx40", EXAMPLES / "staubli_tx40_heldout.py")
+    assert spec is not None and spec.loader is not None
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    dt = 2e-4
+    t = np.arange(0, 15750, 10) * dt  # held-out rows 29250:45000, every 10th
+    predicted = np.arange(t.size, dtype=float)[:, None] * np.ones((1, 6))
+    rows, kept = script.scored_prediction(t, predicted, dt)
+    np.testing.assert_array_equal(rows, np.arange(2927, 4498))  # samples 29270:44980
+    np.testing.assert_array_equal(kept[:, 0], rows - 2925)
+    fine = np.sin(np.arange(15750) * dt * 7.0)[:, None] * np.ones((1, 6))
+    rows, kept = script.scored_prediction(np.arange(15750) * dt, fine, dt)
+    np.testing.assert_array_equal(rows, np.arange(2927, 4498))
+    from scipy import signal
+
+    expected = signal.decimate(fine, 10, axis=0, zero_phase=True)[2:1573]
+    np.testing.assert_allclose(kept, expected, rtol=0, atol=1e-15)
+    measured = np.array([[1.0, 2.0], [-1.0, 2.0]])
+    np.testing.assert_allclose(
+        script.relative_rms(measured * 1.1, measured), [0.1, 0.1], rtol=1e-12
+    )
