@@ -73,6 +73,8 @@ VALUES: dict[str, Any] = {
     "Fv": np.array([1.5, 2.5, 3.5]),
     "Fs": np.array([0.4, 0.5, 0.6]),
     "transmission": np.array([[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [-0.2, 0.3, 1.0]]),
+    "gear_ratios": np.array([100.0, -50.5, 32.0]),
+    "joint_offsets": np.array([0.25, -1.5, 0.125]),
 }
 #: The defaults of a 3-joint RPR arm, written out (docs/conventions.md; docs/models.md).
 DEFAULTS: dict[str, Any] = {
@@ -87,6 +89,8 @@ DEFAULTS: dict[str, Any] = {
     "Fv": np.zeros(3),
     "Fs": np.zeros(3),
     "transmission": np.eye(3),
+    "gear_ratios": np.ones(3),
+    "joint_offsets": np.zeros(3),
 }
 
 
@@ -159,7 +163,14 @@ def test_model_files_keep_every_field(suffix, tmp_path) -> None:
 def test_model_files_leave_out_only_the_defaults_flagged_so() -> None:
     written = model_to_dict(_robot(DEFAULTS))
     omitted = {f.file_key for f in robot_fields.FIELDS if f.omit_default}
-    assert omitted == {"joint_names", "base", "tool", "transmission"}
+    assert omitted == {
+        "joint_names",
+        "base",
+        "tool",
+        "transmission",
+        "gear_ratios",
+        "joint_offsets",
+    }
     assert set(written) == {"format"} | {f.file_key for f in robot_fields.FIELDS} - omitted
     assert set(model_to_dict(_robot())) == {"format"} | {f.file_key for f in robot_fields.FIELDS}
 

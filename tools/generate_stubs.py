@@ -133,6 +133,8 @@ SETTER_TYPES: dict[str, str] = {
     "Fv": ARRAY_LIKE,
     "Fs": ARRAY_LIKE,
     "transmission": f"{ARRAY_LIKE} | None",
+    "gear_ratios": ARRAY_LIKE,
+    "joint_offsets": ARRAY_LIKE,
     "name": "str",
     "joint_names": "typing.Sequence[str]",
     "qlim": ARRAY_LIKE,

@@ -270,6 +270,25 @@ void bind_model(py::module_& m) {
           "per motor and the drive torque is T^T (Ia T qdd + Fv T qd + Fs sign(T qd)). "
           "ValueError naming transmission unless T is finite and invertible "
           "(sigma_min / sigma_max > 1e-12).")
+      .def_property(
+          "gear_ratios",
+          [](const PyModel& self) { return vector_property(self.model->gear_ratios()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX N = parse_drive(v, "gear_ratios", self.model->n());
+            self.modify([&](Model& model) { model.set_gear_ratios(N); });
+          },
+          "Gear ratios (n,), motor angle over joint angle: motor-side logs map to the joints "
+          "through R = diag(gear_ratios) T (docs/data.md). Ones by default; ValueError naming "
+          "gear_ratios for a zero or non-finite value.")
+      .def_property(
+          "joint_offsets",
+          [](const PyModel& self) { return vector_property(self.model->joint_offsets()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX offsets = parse_drive(v, "joint_offsets", self.model->n());
+            self.modify([&](Model& model) { model.set_joint_offsets(offsets); });
+          },
+          "Joint zero offsets (n,): a motor-side log's joint angles are q = R^-1 theta - "
+          "joint_offsets (docs/data.md). Zeros by default.")
       .def(
           "_set_link_physical",
           [](PyModel& self, int i, double mass, py::handle com, py::handle inertia_com) {

@@ -62,6 +62,8 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   Fs_ = VectorX::Zero(n_);
   T_ = MatrixX::Identity(n_, n_);
   update_drive_matrices();
+  gear_ratios_ = VectorX::Ones(n_);
+  joint_offsets_ = VectorX::Zero(n_);
 
   // Bring both conventions to the modified form (joint_transform.hpp). For standard DH the
   // constant Tx(a_{i-1}) Rx(alpha_{i-1}) of the previous row precedes joint i, and link i's DH
@@ -210,6 +212,21 @@ void Model::set_transmission(const Eigen::Ref<const MatrixX>& T) {
   T_ = T;
   transmission_identity_ = T_ == MatrixX::Identity(n_, n_);
   update_drive_matrices();
+}
+
+void Model::set_gear_ratios(const VectorIn& gear_ratios) {
+  require_length(gear_ratios, n_, "gear_ratios");
+  // A zero ratio would make R = diag(gear_ratios) T singular: no joint angle from the motors.
+  for (int i = 0; i < n_; ++i)
+    if (gear_ratios[i] == 0.0)
+      throw std::invalid_argument("gear_ratios: joint " + std::to_string(i + 1) +
+                                  " has a zero gear ratio (expected non-zero values)");
+  gear_ratios_ = gear_ratios;
+}
+
+void Model::set_joint_offsets(const VectorIn& joint_offsets) {
+  require_length(joint_offsets, n_, "joint_offsets");
+  joint_offsets_ = joint_offsets;
 }
 
 void Model::update_drive_matrices() {

@@ -52,6 +52,7 @@ if TYPE_CHECKING:
     from .identification.recursive import RecursiveLeastSquares
     from .identification.streaming import LeastSquaresAccumulator, least_squares_streaming
     from .logs.log_files import Log, load_log, save_log
+    from .logs.motor_side import motor_to_joint
     from .logs.preparation import prepare_log
     from .model import models
     from .model.bounds import DynamicBounds, dynamic_bounds
@@ -87,6 +88,7 @@ _LAZY = {
     "least_squares_streaming": ".identification.streaming",
     "Log": ".logs.log_files",
     "load_log": ".logs.log_files",
+    "motor_to_joint": ".logs.motor_side",
     "save_log": ".logs.log_files",
     "prepare_log": ".logs.preparation",
     "load_model": ".model.model_files",
@@ -162,6 +164,7 @@ __all__ = [
     "load_model",
     "load_result",
     "models",
+    "motor_to_joint",
     "observer",
     "optimize_excitation",
     "payload_from_identified",

@@ -333,6 +333,13 @@ class Model:
         DH table (n, 4), rows [a, alpha, d, theta] as given.
         """
     @property
+    def gear_ratios(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Gear ratios (n,), motor angle over joint angle: motor-side logs map to the joints through R = diag(gear_ratios) T (docs/data.md). Ones by default; ValueError naming gear_ratios for a zero or non-finite value.
+        """
+    @gear_ratios.setter
+    def gear_ratios(self, arg1: numpy.typing.ArrayLike) -> None: ...
+    @property
     def gravity_vector(self) -> numpy.typing.NDArray[numpy.float64]:
         """
         Gravity acceleration in world coordinates (3,).
@@ -346,6 +353,13 @@ class Model:
         """
     @joint_names.setter
     def joint_names(self, arg1: typing.Sequence[str]) -> None: ...
+    @property
+    def joint_offsets(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Joint zero offsets (n,): a motor-side log's joint angles are q = R^-1 theta - joint_offsets (docs/data.md). Zeros by default.
+        """
+    @joint_offsets.setter
+    def joint_offsets(self, arg1: numpy.typing.ArrayLike) -> None: ...
     @property
     def joint_types(self) -> str: ...
     @property

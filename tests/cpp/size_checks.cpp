@@ -210,6 +210,12 @@ int main() {
   for (std::size_t i = 0; i < names.size(); ++i) names[i] = "j" + std::to_string(i);
   names.back() = "";  // one empty
   expect_rejected("Model", "joint_names", [&] { editable.set_joint_names(names); }, false);
+  expect_rejected("Model", "gear_ratios", [&] { editable.set_gear_ratios(short_vector); }, false);
+  VectorX zero_ratio = VectorX::Ones(n);
+  zero_ratio[1] = 0.0;  // R = diag(gear_ratios) T would be singular
+  expect_rejected("Model", "gear_ratios", [&] { editable.set_gear_ratios(zero_ratio); }, false);
+  expect_rejected(
+      "Model", "joint_offsets", [&] { editable.set_joint_offsets(long_vector); }, false);
   dynid::RecursiveLeastSquares rls(4);
   const MatrixX block = MatrixX::Ones(2, 4);
   expect_rejected(

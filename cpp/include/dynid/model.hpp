@@ -110,6 +110,18 @@ class Model {
   const MatrixX& drive_inertia() const { return drive_inertia_; }
   const MatrixX& drive_damping() const { return drive_damping_; }
 
+  // How a motor-side recording maps to the joints (issue 20; docs/data.md, "Motor-side logs"):
+  // motor angles theta = R (q + joint_offsets) with R = diag(gear_ratios) T, so that
+  // q = R^-1 theta - joint_offsets and tau = R^T tau_m (virtual work, as for T above). Gear
+  // ratios are ones and offsets zeros by default. Data for the user of the model, like qlim: no
+  // algorithm reads them (the drive terms above are already in joint units). set_gear_ratios
+  // throws std::invalid_argument naming `gear_ratios` unless it holds n finite non-zero values
+  // (R must be invertible); set_joint_offsets naming `joint_offsets` unless n finite values.
+  const VectorX& gear_ratios() const { return gear_ratios_; }
+  const VectorX& joint_offsets() const { return joint_offsets_; }
+  void set_gear_ratios(const VectorIn& gear_ratios);
+  void set_joint_offsets(const VectorIn& joint_offsets);
+
   // ---- derived quantities: the algorithms' view (unchecked index; its types are in
   // dynid::detail and may change between releases) ----
   const detail::JointGeometry& joint(int i) const { return joints_[i]; }
@@ -139,6 +151,7 @@ class Model {
   VectorX Ia_, Fv_, Fs_;
   MatrixX T_, drive_inertia_, drive_damping_;
   bool transmission_identity_ = true;
+  VectorX gear_ratios_, joint_offsets_;
 
   std::vector<detail::JointGeometry> joints_;
   std::vector<RigidBodyParameters> bodies_;

@@ -32,6 +32,7 @@ def log_options(args: argparse.Namespace, joint_names: Any = None) -> dict[str, 
         # motor currents as tau (UR RTDE's actual_current_i; a ROS bag's effort)
         "current": getattr(args, "current", False),
         "drop_nonfinite": args.drop_nonfinite,
+        "sample_time": getattr(args, "sample_time", None),
         **ros_bag_options(args, joint_names),
     }
 
@@ -52,6 +53,34 @@ def log_reading(log: Any) -> str:
     after = log.notes[loaded[-1] + 1 :] if loaded else []
     done = [note for note in after if not note.startswith("skipped the first")]
     return f"{log.format or 'unknown format'}" + (f"; {'; '.join(done)}" if done else "")
+
+
+def load_log_of(args: argparse.Namespace, joint_names: Any = None) -> Any:
+    """``load_log(args.log, ...)``; for a motor-side log without the warning of positions beyond
+    100 rad, which motor angles (before the gear) may well exceed: ``to_joint_side`` checks the
+    joint angles instead."""
+    import warnings
+
+    from ..logs.log_files import load_log
+
+    with warnings.catch_warnings():
+        if getattr(args, "motor_side", False):
+            warnings.filterwarnings("ignore", message=r".*q: positions up to", category=UserWarning)
+        return load_log(args.log, **log_options(args, joint_names))
+
+
+def to_joint_side(args: argparse.Namespace, log: Any, robot: Any) -> Any:
+    """With ``--motor-side``, ``log`` mapped to the joints through ``robot``'s gear ratios,
+    transmission and joint offsets (dynid.logs.motor_side); otherwise ``log`` as it is."""
+    if not getattr(args, "motor_side", False):
+        return log
+    from ..logs.log_files import check_plausible
+    from ..logs.motor_side import motor_to_joint
+
+    joint_log = motor_to_joint(log, robot)
+    print(f"note: {joint_log.notes[-1]}", flush=True)
+    check_plausible(joint_log, f"{args.log} (joint side)", unit_given=True)
+    return joint_log
 
 
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -81,10 +110,11 @@ def identify(args: argparse.Namespace) -> None:
     from ..export.output_folder import check_output_path
     from ..export.result_files import save_result
     from ..identification.log_identification import identify_log
-    from ..logs.log_files import load_log
     from ..model.model_files import load_model
 
     check_output_path(args.output, args.overwrite, inputs=identify_inputs(args))  # before the work
+    if args.current and args.motor_side:
+        raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     if args.current:
         identify_from_currents(args)
         return
@@ -98,12 +128,13 @@ def identify(args: argparse.Namespace) -> None:
         raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
     robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
-    log = load_log(args.log, **log_options(args, robot.joint_names))
+    log = load_log_of(args, robot.joint_names)
     step(
         f"log {args.log} ({log_reading(log)}): {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, "
         f"{log.duration:.4g} s" + (f" (first {args.skip} skipped)" if args.skip else "")
     )
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
+    log = to_joint_side(args, log, robot)
     result = identify_log(
         log,
         robot,
@@ -190,12 +221,13 @@ def validate(args: argparse.Namespace) -> None:
     from ..export.result_files import load_result, save_validation
     from ..identification.log_identification import run_validation
     from ..identification.validation import validation_table
-    from ..logs.log_files import load_log
 
     check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
     step = _steps(3)
+    if args.current and args.motor_side:
+        raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     result = load_result(args.result)
-    log = load_log(args.log, **log_options(args, result.robot.joint_names))
+    log = to_joint_side(args, load_log_of(args, result.robot.joint_names), result.robot)
     if args.current:
         from ..identification.drive_gains import torques_from_currents
 

@@ -96,6 +96,7 @@ def _add_identify(subcommands: Any) -> None:
     )
     _add_current(p)
     _add_preparation(p)
+    _add_motor_side(p)
     p.add_argument(
         "--min-velocity",
         type=float,
@@ -125,6 +126,7 @@ def _add_validate(subcommands: Any) -> None:
         "(a result of `dynid identify --current`)",
     )
     _add_preparation(p)
+    _add_motor_side(p)
     _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
 
@@ -284,6 +286,24 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="drop the log's rows holding a NaN or inf (counted in the output) instead of "
         "refusing the file",
+    )
+    p.add_argument(
+        "--sample-time",
+        type=float,
+        metavar="DT",
+        help="sample time [s] of a log without a time vector, t = 0, DT, 2 DT, ... (an NPZ "
+        "key 'sample_time' is read without it)",
+    )
+
+
+def _add_motor_side(p: argparse.ArgumentParser) -> None:
+    """A motor-side log (commands.to_joint_side)."""
+    p.add_argument(
+        "--motor-side",
+        action="store_true",
+        help="LOG holds motor angles and motor torques: mapped to the joints through the "
+        "model's gear_ratios, transmission and joint_offsets, q = R^-1 theta - joint_offsets, "
+        "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md)",
     )
 
 

@@ -29,7 +29,8 @@ class ReadOptions:
     own mapping; ``time_unit``: the time stamps' unit, None for the format's own (seconds unless
     the format says otherwise); ``current``: read motor currents instead of joint torques where
     the format records both (UR RTDE); ``topic``, ``joint_names``: for the ROS bag reader;
-    ``drop_nonfinite``: drop rows with a NaN or inf instead of refusing the file.
+    ``drop_nonfinite``: drop rows with a NaN or inf instead of refusing the file;
+    ``sample_time``: seconds between samples of a log without a time vector (t = 0, dt, ...).
     """
 
     columns: Mapping[str, str] | None = None
@@ -38,6 +39,7 @@ class ReadOptions:
     topic: str | None = None
     joint_names: tuple[str, ...] | None = None
     drop_nonfinite: bool = False
+    sample_time: float | None = None
 
 
 @dataclass(frozen=True)

@@ -223,6 +223,7 @@ def load_log(
     drop_nonfinite: bool = False,
     topic: str | None = None,
     joint_names: Sequence[str] | None = None,
+    sample_time: float | None = None,
 ) -> Log:
     """Load a log in any registered format (``dynid.logs.formats``; docs/data.md): dynid's NPZ
     and CSV, UR RTDE, libfranka, pyfri/FRI, any CSV, MATLAB. The format is chosen by the suffix
@@ -237,7 +238,9 @@ def load_log(
     where the format records them (UR RTDE ``actual_current_i``). ``drop_nonfinite`` drops rows
     holding a NaN or inf (counted in the notes) instead of refusing the file. ``topic`` and
     ``joint_names`` are for ROS bags (the topic, and the model's joint names the message's joints
-    are matched to). Errors name the file and what is missing or malformed. A sampling rate no
+    are matched to). A log without a time vector (a motor-side recording such as the Staubli
+    TX40's) needs ``sample_time`` [s], or an NPZ key ``sample_time``: t = 0, dt, 2 dt, ...
+    Errors name the file and what is missing or malformed. A sampling rate no
     robot log has (outside PLAUSIBLE_RATE: nanosecond stamps read as seconds give 2e-7 Hz and a
     meaningless fit) is an error, unless ``time_unit`` was given (then a warning: the caller
     said what the stamps count); a position range no robot has is a warning.
@@ -258,7 +261,10 @@ def load_log(
         ):
             raise ValueError(f"joint_names: expected a sequence of names, got {joint_names!r}")
         joint_names = tuple(joint_names)
+    if sample_time is not None:
+        sample_time = check_sample_time(sample_time, "sample_time")
     options = ReadOptions(
+        sample_time=sample_time,
         columns=check_columns(columns) if columns is not None else None,
         time_unit=time_unit,
         current=bool(current),
@@ -279,6 +285,19 @@ def load_log(
         log = log.slice(skip, None, note=f"skipped the first {skip} samples")
     check_plausible(log, path.name, unit_given=time_unit is not None)
     return log
+
+
+def check_sample_time(value: Any, name: str) -> float:
+    """A sample time in seconds: one finite number > 0 (ValueError naming ``name``)."""
+    try:
+        if isinstance(value, (str, bytes, bool)):
+            raise TypeError
+        dt = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number of seconds, got {value!r}") from None
+    if not np.isfinite(dt) or dt <= 0.0:
+        raise ValueError(f"{name}: expected a finite sample time > 0 s, got {value!r}")
+    return dt
 
 
 #: Sampling rates outside this band [Hz] are not a robot log read in the right time unit.

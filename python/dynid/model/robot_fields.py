@@ -29,8 +29,9 @@ import numpy as np
 
 #: Groups of fields. ``structure``: the constructor's arguments, fixed for the robot's life (they
 #: decide n and the joint frames); ``label``; ``placement`` (gravity, base and tool transforms);
-#: ``limits``; ``links`` (the standard inertial parameters); ``drive`` (the drive terms).
-GROUPS = ("structure", "label", "placement", "limits", "links", "drive")
+#: ``limits``; ``links`` (the standard inertial parameters); ``drive`` (the drive terms);
+#: ``recording`` (how a motor-side log maps to the joints: no algorithm reads it).
+GROUPS = ("structure", "label", "placement", "limits", "links", "drive", "recording")
 #: How ``dynid info`` shows a field (:mod:`dynid.export.summary` has one layout per value):
 #: ``title``, the first line; ``joint table``, the DH table itself; ``joint columns``, columns
 #: of the DH table (one per ``label`` word); ``names``, one line of n words after the ``label``;
@@ -148,6 +149,11 @@ FIELDS: tuple[RobotField, ...] = (
     # structural: T couples the drive columns of the regressor (docs/transmission.md).
     RobotField("transmission", "array", ("n", "n"), "drive",     "omit_default structural",
                "matrix", label="transmission T (motor velocities T qd; Ia, Fv, Fs per motor)"),
+    # A motor-side log: q = R^-1 theta - joint_offsets, tau = R^T tau_m, R = diag(gear_ratios) T
+    # (docs/data.md, "Motor-side logs"; dynid.logs.motor_side). Not structural: the regressor
+    # is in joint units.
+    RobotField("gear_ratios",  "array", ("n",),     "recording", "omit_default",  "per joint"),
+    RobotField("joint_offsets", "array", ("n",),    "recording", "omit_default",  "per joint"),
 )
 # fmt: on
 

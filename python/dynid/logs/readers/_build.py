@@ -52,10 +52,10 @@ def table_log(
     for required in ("q", "tau"):
         if required not in mapping:
             raise ValueError(f"columns: {required!r} missing from the mapping {_shown(mapping)}")
-    found = _find(table, mapping, options, time_from is None)
+    found = _find(table, mapping, options, time_from is None and options.sample_time is None)
     used = sorted({c for names in found.values() for c in names})
     extra: list[int] = []
-    if "t" not in found and time_from is not None:
+    if "t" not in found and time_from is not None and options.sample_time is None:
         if options.time_unit not in (None, "s"):
             raise ValueError(
                 f"time_unit: {fmt}'s time is {' + '.join(time_from[0])} in seconds; map t to a "
@@ -71,8 +71,7 @@ def table_log(
     arrays: dict[str, NDArray[np.float64]] = {}
     if "t" in found:
         arrays["t"] = column(found["t"][0])
-    else:
-        assert time_from is not None
+    elif time_from is not None:
         arrays["t"] = time_from[1](*(column(c) for c in extra))
         unit = "s"
     for signal in ("q", "qd", "qdd", "tau"):
@@ -98,8 +97,11 @@ def _find(
     """Each signal's column indices; ``t`` exactly one column."""
     if not table.has_header:
         assert options.columns
-        if "t" not in options.columns:
-            raise ValueError("columns: the file has no header; give the time's column too (t=0)")
+        if "t" not in options.columns and options.sample_time is None:
+            raise ValueError(
+                "columns: the file has no header; give the time's column too (t=0), or the "
+                "sample time (sample_time / --sample-time)"
+            )
         width = len(table.names)
         names = {s: index_names(str(p), width, s) for s, p in options.columns.items()}
     else:
@@ -148,6 +150,20 @@ def finish(
     with a NaN or inf are dropped with ``options.drop_nonfinite`` (a note counts them), else
     refused naming the first one and the option."""
     added: list[str] = []
+    if "t" in arrays and options.sample_time is not None:
+        raise ValueError("sample_time: given, but the log has a time vector; give one of them")
+    if "t" not in arrays:  # a recording of samples at a fixed rate (the Staubli TX40's)
+        if options.sample_time is None:
+            raise ValueError(
+                "no time vector (key or column 't' or 'times'): give the sample time with "
+                "sample_time / --sample-time, or an NPZ key 'sample_time'"
+            )
+        samples = len(np.asarray(arrays["q"]))
+        arrays = {"t": np.arange(samples, dtype=float) * options.sample_time, **arrays}
+        unit = "s"
+        timeless = "no time vector: t = 0, dt, 2 dt, ... from the sample time"
+    else:
+        timeless = ""
     lengths = {len(a) for a in arrays.values()}
     if len(lengths) == 1 and all(np.ndim(a) in (1, 2) for a in arrays.values()):
         T = lengths.pop()
@@ -177,6 +193,8 @@ def finish(
     if seconds != 1.0:
         arrays = dict(arrays, t=np.asarray(arrays["t"], dtype=float) * seconds)
         added.append(f"time stamps in {unit}, converted to s")
+    if timeless:
+        added.append(timeless)
     return Log(**arrays, source=str(path), format=fmt, notes=[*notes, note, *added])
 
 

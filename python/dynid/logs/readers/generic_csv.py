@@ -34,8 +34,11 @@ def _dynid_layout(path: Path, table: Table, options: ReadOptions) -> Log:
     if duplicates:
         raise ValueError(f"duplicate columns in the header: {', '.join(duplicates)}")
     index = {name: c for c, name in enumerate(header)}
-    if "t" not in index:
-        raise ValueError(f"missing column 't'; found columns: {name_list(header)}")
+    if "t" not in index and options.sample_time is None:
+        raise ValueError(
+            f"missing column 't' (or give the sample time, sample_time / --sample-time); found "
+            f"columns: {name_list(header)}"
+        )
     groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
     for name, c in index.items():
         match = _COLUMN.match(name)
@@ -45,7 +48,7 @@ def _dynid_layout(path: Path, table: Table, options: ReadOptions) -> Log:
         raise ValueError(f"missing columns q1..qn; found columns: {name_list(header)}")
     n = max(groups["q"])
     wanted = range(1, n + 1)
-    columns: dict[str, list[int]] = {"t": [index["t"]]}
+    columns: dict[str, list[int]] = {"t": [index["t"]]} if "t" in index else {}
     for name, found in groups.items():
         if not found:
             if name == "tau":

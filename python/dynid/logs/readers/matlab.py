@@ -38,7 +38,9 @@ def read(path: Path, options: ReadOptions) -> Log:
     except (ValueError, OSError, NotImplementedError, TypeError) as exc:
         raise ValueError(f"not a readable MATLAB file ({type(exc).__name__}: {exc})") from None
     variables = {k: v for k, v in contents.items() if not k.startswith("__")}
-    arrays, how = keyed_arrays(list(variables), variables.__getitem__, options.columns)
+    arrays, how = keyed_arrays(
+        list(variables), variables.__getitem__, options.columns, need_t=options.sample_time is None
+    )
     arrays, turned = _orient(arrays)
     note = f"loaded from {path.name} (MATLAB, {how})"
     if turned:

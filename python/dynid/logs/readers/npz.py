@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import zipfile
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -14,7 +15,7 @@ from numpy.typing import NDArray
 
 from ..columns import matching
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log
+from ..log_files import Log, check_sample_time
 from ..messages import name_list
 from ._build import finish
 
@@ -40,18 +41,30 @@ def read(path: Path, options: ReadOptions) -> Log:
         _check_members(path)
         notes = [str(s) for s in data["notes"]] if "notes" in found else []
         stored = str(data["format"]) if "format" in found else ""
-        arrays, how = keyed_arrays(found, data.__getitem__, options.columns)
+        timeless = not ({"t", "times"} & set(found)) and not (options.columns or {}).get("t")
+        if timeless and "sample_time" in found and options.sample_time is None:
+            # the recording's own sample time (the Staubli TX40 data's key)
+            own = check_sample_time(data["sample_time"][()], "key 'sample_time'")
+            options = replace(options, sample_time=own)
+        arrays, how = keyed_arrays(
+            found, data.__getitem__, options.columns, need_t=options.sample_time is None
+        )
     note = f"loaded from {path.name} (NPZ, {how})"
     return finish(arrays, path, options, fmt=stored or NAME, note=note, notes=notes)
 
 
 def keyed_arrays(
-    found: Sequence[str], get: Callable[[str], Any], columns: Mapping[str, str] | None
+    found: Sequence[str],
+    get: Callable[[str], Any],
+    columns: Mapping[str, str] | None,
+    *,
+    need_t: bool = True,
 ) -> tuple[dict[str, NDArray], str]:
     """The signals of a file of named arrays (NPZ keys, MATLAB variables), and how they were
-    found (for the load note): by ``columns``, else by dynid's or FloBaRoID's names."""
+    found (for the load note): by ``columns``, else by dynid's or FloBaRoID's names. Without
+    ``need_t`` (a sample time was given) a missing time vector is no error."""
     if columns:
-        return mapped_arrays(found, lambda name: np.asarray(get(name)), columns), (
+        return mapped_arrays(found, lambda name: np.asarray(get(name)), columns, need_t=need_t), (
             f"columns {dict(columns)}"
         )
     arrays: dict[str, NDArray] = {}
@@ -66,7 +79,7 @@ def keyed_arrays(
             except ValueError as exc:  # object arrays need pickle, refused on purpose
                 raise ValueError(f"key {present[0]!r}: unreadable ({exc})") from None
             flobaroid |= present[0] != name
-    for name in ("t", "q", "tau"):
+    for name in ("t", "q", "tau") if need_t else ("q", "tau"):
         if name not in arrays:
             alias = KEYS[name][1]
             raise ValueError(
@@ -80,14 +93,19 @@ def keyed_arrays(
 
 
 def mapped_arrays(
-    names: Sequence[str], get: Callable[[str], NDArray], mapping: Mapping[str, str]
+    names: Sequence[str],
+    get: Callable[[str], NDArray],
+    mapping: Mapping[str, str],
+    *,
+    need_t: bool = True,
 ) -> dict[str, NDArray]:
     """The signals named by ``mapping`` (keys or patterns, :mod:`dynid.logs.columns`): one 2-D
     array, or several 1-D ones stacked as joints in natural order; ``t`` is one 1-D array."""
     for required in ("q", "tau"):
         if required not in mapping:
             raise ValueError(f"columns: {required!r} missing from the mapping {dict(mapping)}")
-    spec = {"t": "t" if "t" in names else "times", **mapping}
+    has_t = "t" in names or "times" in names
+    spec = {**({"t": "t" if "t" in names else "times"} if need_t or has_t else {}), **mapping}
     arrays: dict[str, NDArray] = {}
     for signal, pattern in spec.items():
         found = matching(pattern, names, signal)
