@@ -36,8 +36,8 @@ def _dynid_layout(path: Path, table: Table, options: ReadOptions) -> Log:
     index = {name: c for c, name in enumerate(header)}
     if "t" not in index and options.sample_time is None:
         raise ValueError(
-            f"missing column 't' (or give the sample time, sample_time / --sample-time); found "
-            f"columns: {name_list(header)}"
+            f"missing column 't'; found columns: {name_list(header)} (a log without a time "
+            "column needs its sample time: sample_time / --sample-time)"
         )
     groups: dict[str, dict[int, int]] = {"q": {}, "qd": {}, "qdd": {}, "tau": {}}
     for name, c in index.items():

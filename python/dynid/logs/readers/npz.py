@@ -64,7 +64,7 @@ def keyed_arrays(
     found (for the load note): by ``columns``, else by dynid's or FloBaRoID's names. Without
     ``need_t`` (a sample time was given) a missing time vector is no error."""
     if columns:
-        return mapped_arrays(found, lambda name: np.asarray(get(name)), columns, need_t=need_t), (
+        return mapped_arrays(found, lambda name: np.asarray(get(name)), columns), (
             f"columns {dict(columns)}"
         )
     arrays: dict[str, NDArray] = {}
@@ -96,16 +96,15 @@ def mapped_arrays(
     names: Sequence[str],
     get: Callable[[str], NDArray],
     mapping: Mapping[str, str],
-    *,
-    need_t: bool = True,
 ) -> dict[str, NDArray]:
     """The signals named by ``mapping`` (keys or patterns, :mod:`dynid.logs.columns`): one 2-D
     array, or several 1-D ones stacked as joints in natural order; ``t`` is one 1-D array."""
     for required in ("q", "tau"):
         if required not in mapping:
             raise ValueError(f"columns: {required!r} missing from the mapping {dict(mapping)}")
+    # Without a time vector the Log is made from the sample time, or refused naming it.
     has_t = "t" in names or "times" in names
-    spec = {**({"t": "t" if "t" in names else "times"} if need_t or has_t else {}), **mapping}
+    spec = {**({"t": "t" if "t" in names else "times"} if has_t else {}), **mapping}
     arrays: dict[str, NDArray] = {}
     for signal, pattern in spec.items():
         found = matching(pattern, names, signal)
