@@ -24,18 +24,48 @@ def log_options(args: argparse.Namespace) -> dict[str, Any]:
     from ..logs.columns import parse_columns
 
     columns = parse_columns(args.columns) if args.columns is not None else None
-    return {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+    options = {"skip": args.skip, "columns": columns, "time_unit": args.time_unit}
+    if getattr(args, "skip_end", 0):
+        options["skip_end"] = args.skip_end
+    return options
+
+
+#: prepare_log options and the command-line flags that set them.
+PREPARATION_FLAGS = {
+    "cutoff": "cutoff",
+    "order": "order",
+    "decimate": "decimate",
+    "min_velocity": "min_velocity",
+    "outlier_k": "outliers",
+    "nonuniform": "nonuniform",
+    "trim_edges": "edge_trim",
+}
+
+
+def given_preparation(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``prepare_log`` options given on the command line (nothing for those left out)."""
+    given = {
+        key: getattr(args, flag)
+        for key, flag in PREPARATION_FLAGS.items()
+        if getattr(args, flag, None) is not None
+    }
+    if "order" in given and "cutoff" not in given:
+        given.pop("order")  # the order of a low-pass that is not asked for
+    return given
 
 
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
-    """The ``prepare_log`` options given on the command line."""
-    options: dict[str, Any] = {"cutoff": args.cutoff, "decimate": args.decimate}
-    if args.cutoff is not None:
-        options["order"] = args.order
-    for key, option in (("min_velocity", "min_velocity"), ("outlier_k", "outliers")):
-        if getattr(args, option, None) is not None:
-            options[key] = getattr(args, option)
-    return {k: v for k, v in options.items() if v is not None and not (k == "decimate" and v == 1)}
+    """The ``prepare_log`` options given on the command line, defaults left out (the order 4 of
+    a --cutoff made explicit)."""
+    options = given_preparation(args)
+    if "cutoff" in options:
+        options.setdefault("order", 4)
+    return _without_defaults(options)
+
+
+def _without_defaults(options: dict[str, Any]) -> dict[str, Any]:
+    defaults = {"decimate": 1, "nonuniform": "resample", "trim_edges": True}
+    return {k: v for k, v in options.items() if not (k in defaults and v == defaults[k])}
 
 
 def demo(args: argparse.Namespace) -> None:

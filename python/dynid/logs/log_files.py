@@ -226,11 +226,13 @@ def load_log(
     skip: int = 0,
     columns: Mapping[str, str] | None = None,
     time_unit: str | None = None,
+    skip_end: int = 0,
 ) -> Log:
     """Load a log from an ``.npz`` or ``.csv`` file (formats in ``docs/data.md``).
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
-    the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
+    the LWR4+ logs skips 500); ``skip_end`` drops the last samples (e.g. a final rest; the
+    filters' edge transients are trimmed by :func:`dynid.prepare_log` itself). ``columns`` maps signals of a foreign log to its columns or keys
     (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.logs.columns`) and
     ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads seconds.
     Errors name the file and what is missing or malformed. A sampling rate no robot log has
@@ -247,6 +249,7 @@ def load_log(
             f"path: unknown extension {path.suffix!r} of {path}; expected .npz or .csv"
         )
     skip = count(skip, "skip", 0)
+    skip_end = count(skip_end, "skip_end", 0)
     mapping = check_columns(columns) if columns is not None else None
     seconds = time_scale("s" if time_unit is None else time_unit)
     try:
@@ -259,6 +262,12 @@ def load_log(
         if skip > log.T - 2:
             raise ValueError(f"skip: {skip} leaves fewer than 2 of the {log.T} samples of {path}")
         log = log.slice(skip, None, note=f"skipped the first {skip} samples")
+    if skip_end:
+        if skip_end > log.T - 2:
+            raise ValueError(
+                f"skip_end: {skip_end} leaves fewer than 2 of the {log.T} samples of {path}"
+            )
+        log = log.slice(0, log.T - skip_end, note=f"skipped the last {skip_end} samples")
     check_plausible(log, path.name, unit_given=time_unit is not None)
     return log
 
