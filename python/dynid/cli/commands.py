@@ -205,13 +205,18 @@ def validate(args: argparse.Namespace) -> None:
             "holds currents",
             flush=True,
         )
-    validation = run_validation(result, log, preparation=preparation_options(args))
+    options, sources = validation_preparation(result, args)
+    validation = run_validation(result, log, preparation=options)
     step(
         f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
         f"log {args.log}: {validation.log.T} samples"
     )
+    print(f"preparation applied: {sources}", flush=True)
+    new_notes = validation.log.notes[len(log.notes) :]
+    if new_notes:
+        print("prepared: " + "; ".join(new_notes), flush=True)
     for note in validation.notes:
-        print(f"note: {note} (--cutoff)", flush=True)
+        print(f"note: {note}", flush=True)
     step("predicted the torques")
     print(
         validation_table(
@@ -227,6 +232,37 @@ def validate(args: argparse.Namespace) -> None:
         overwrite=args.overwrite,
     )
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def validation_preparation(result: Any, args: argparse.Namespace) -> tuple[dict[str, Any], str]:
+    """The preparation of ``dynid validate``: the training log's, as recorded in the result
+    (``training.preparation``), unless --no-recorded-preparation; each option given on the
+    command line replaces the recorded one. Returns the options and, in words, where each came
+    from."""
+    recorded: dict[str, Any] = {}
+    if args.recorded_preparation:
+        recorded = dict(result.training.get("preparation", {}))
+        recorded.pop("reference_tau", None)  # a torque of the training log: no use here
+    given = given_preparation(args)
+    options = {**recorded, **given}
+    if "cutoff" in options:
+        options.setdefault("order", 4)
+    options = _without_defaults(options)
+    if not options:
+        return options, "none (the log as given, qd and qdd differentiated when missing)"
+    flags = {k: f"--{f.replace('_', '-')}" for k, f in PREPARATION_FLAGS.items()}
+    flags["trim_edges"] = "--edge-trim"
+
+    def flag(key: str, value: Any) -> str:
+        if key == "trim_edges":
+            return "--edge-trim" if value else "--no-edge-trim"
+        return f"{flags[key]} {value}"
+
+    words = [
+        flag(k, v) + (" (command line)" if k in given else " (recorded in the result)")
+        for k, v in options.items()
+    ]
+    return options, ", ".join(words)
 
 
 def export(args: argparse.Namespace) -> None:

@@ -116,6 +116,13 @@ def _add_validate(subcommands: Any) -> None:
         "(a result of `dynid identify --current`)",
     )
     _add_preparation(p)
+    p.add_argument(
+        "--recorded-preparation",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="apply the preparation recorded in the result (the training log's), each option "
+        "given here replacing the recorded one (default: on)",
+    )
     _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
 
