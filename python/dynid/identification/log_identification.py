@@ -375,7 +375,7 @@ def identify_log(
     prepared = _with_derivatives(prepare_log(log, **_sample_options(options)), robot.n, robot.name)
     qd, qdd = prepared.qd, prepared.qdd
     assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
-    keep, keep_note = _moving_rows(qd, options.get("min_velocity"))
+    rows, rows_note = _moving_rows(qd, options.get("min_velocity"))
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
     names, expressions = list(base.names), list(base.expressions)
     for block in blocks:
@@ -418,8 +418,8 @@ def identify_log(
             ],
             axis=2,
         )
-        if keep is not None:  # a zero row adds nothing to the least-squares objective
-            standard = np.where(keep[:, :, None], standard, 0.0)
+        if rows is not None:  # a zero row adds nothing to the least-squares objective
+            standard = np.where(rows[:, :, None], standard, 0.0)
         selected = np.concatenate(
             [base.independent, np.arange(len(base.parameter_names), standard.shape[2])]
         )
@@ -436,7 +436,7 @@ def identify_log(
         Y = chunk_regressor(c)
         if keep:
             cache[i] = Y
-        accumulator.add(Y, prepared.tau[c], None if keep is None else keep[c])
+        accumulator.add(Y, prepared.tau[c], None if rows is None else rows[c])
     # The physical fit needs the least squares only for the rank, the condition number and the
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
@@ -448,7 +448,7 @@ def identify_log(
     result.covariance = fit.covariance
     result.excluded = fit.excluded
     if standard is not None:
-        tau = prepared.tau if keep is None else np.where(keep, prepared.tau, 0.0)
+        tau = prepared.tau if rows is None else np.where(rows, prepared.tau, 0.0)
         _physical(
             result, standard, tau, fit.noise_variance, prior_robot, prior_weight or 0.0, prior
         )
@@ -464,8 +464,8 @@ def identify_log(
         "duration_s": prepared.duration,
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
-        "notes": list(prepared.notes) + keep_note + block_notes,
-        "metrics": kept_row_metrics(prepared.tau, result.fitted, keep),
+        "notes": list(prepared.notes) + rows_note + block_notes,
+        "metrics": kept_row_metrics(prepared.tau, result.fitted, rows),
     }
     return result
 
@@ -563,8 +563,8 @@ def run_validation(
     prepared = prepare_log(log, **sample_options) if sample_options else log
     predicted = result.predict(prepared)
     qd = prepared.qd if prepared.qd is not None else _with_derivatives(prepared, result.n, "").qd
-    keep, keep_note = _moving_rows(qd, options.get("min_velocity"))
-    notes = list(keep_note)
+    rows, rows_note = _moving_rows(qd, options.get("min_velocity"))
+    notes = list(rows_note)
     trained = result.training.get("preparation", {}).get("cutoff")
     if trained != options.get("cutoff"):
         notes.append(
@@ -572,7 +572,7 @@ def run_validation(
             f"{_filtered(options.get('cutoff'))}"
         )
     return LogValidation(
-        prepared, predicted, kept_row_metrics(prepared.tau, predicted, keep), options, notes
+        prepared, predicted, kept_row_metrics(prepared.tau, predicted, rows), options, notes
     )
 
 
