@@ -35,9 +35,7 @@ def test_min_velocity_leaves_out_rows_per_joint(arm, noisy) -> None:
     the same theta (1e-10) and the same per-joint errors on the rows kept; more rows are kept
     than whole samples would be."""
     v = 0.3
-    result = identify_log(
-        noisy, arm, friction=True, method="ols", preparation={"min_velocity": v}
-    )
+    result = identify_log(noisy, arm, friction=True, method="ols", preparation={"min_velocity": v})
     Y = result.regressor(noisy.q, noisy.qd, noisy.qdd)  # (T, n, p)
     keep = np.abs(noisy.qd) >= v
     A = np.concatenate([Y[keep[:, j], j, :] for j in range(arm.n)])
@@ -75,7 +73,9 @@ def test_min_velocity_rows_with_wls_weigh_each_joint_by_its_own_rows(arm, noisy)
     b = [noisy.tau[keep[:, j], j] for j in range(arm.n)]
     first = np.linalg.lstsq(np.concatenate(A), np.concatenate(b), rcond=None)[0]
     N, p = sum(a.shape[0] for a in A), first.size
-    sigma = [np.sqrt(np.sum((a @ first - y) ** 2) / (a.shape[0] * (N - p) / N)) for a, y in zip(A, b)]
+    sigma = [
+        np.sqrt(np.sum((a @ first - y) ** 2) / (a.shape[0] * (N - p) / N)) for a, y in zip(A, b)
+    ]
     weighted = np.linalg.lstsq(
         np.concatenate([a / s for a, s in zip(A, sigma)]),
         np.concatenate([y / s for y, s in zip(b, sigma)]),
@@ -107,7 +107,12 @@ def test_validate_applies_the_recorded_preparation(arm, noisy, tmp_path, capsys)
 
     def validate(name: str, *extra: str) -> tuple[str, dict]:
         out = tmp_path / name
-        assert main(["validate", str(ident), str(tmp_path / "check.npz"), *extra, "--output", str(out)]) == 0
+        assert (
+            main(
+                ["validate", str(ident), str(tmp_path / "check.npz"), *extra, "--output", str(out)]
+            )
+            == 0
+        )
         return capsys.readouterr().out, json.loads((out / "validation.json").read_text())
 
     printed, report = validate("v1")

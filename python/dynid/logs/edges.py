@@ -4,7 +4,7 @@ Forward-backward filtering extends the signal at both ends (odd extension, as
 ``scipy.signal.sosfiltfilt``) and the output near an end depends on that guess. A log that starts
 or stops at rest is extended well; a log cut mid-motion is not, and the error, amplified twice by
 the differentiation that follows, reached 1,400 rad/s^2 of acceleration against a typical 27-100
-on the Staubli TX40 recording (issue 20; ../shared/data/staubli_tx40/README.md). The error at
+on the Staubli TX40 recording cut mid-motion (issue 20). The error at
 distance m from an end is the extension's error seen through the zero-phase impulse response at
 lags >= m, so it has died out where that response has: :func:`edge_trim` counts the samples until
 the response stays below EDGE_FRACTION of its peak.

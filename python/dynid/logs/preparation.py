@@ -170,8 +170,18 @@ def prepare_log(
             )
 
     # 1-4 and 7 per segment
-    options = _SegmentOptions(cutoff, order, differentiate, factor, spikes_wanted, outlier_k,
-                              resample, step, bool(trim_edges), log.fs)
+    options = _SegmentOptions(
+        cutoff,
+        order,
+        differentiate,
+        factor,
+        spikes_wanted,
+        outlier_k,
+        resample,
+        step,
+        bool(trim_edges),
+        log.fs,
+    )
     done: list[_Segment] = []
     for number, part in enumerate(parts, start=1):
         piece = log.slice(part.start, part.stop, note="")
@@ -187,12 +197,18 @@ def prepare_log(
     longest = max(done, key=lambda s: s.log.T)
     steps_notes = longest.log.notes
     if len(parts) > 1:
-        steps_notes = [f"each segment (as the longest, {longest.log.T} samples): {n}"
-                       for n in steps_notes]
+        steps_notes = [
+            f"each segment (as the longest, {longest.log.T} samples): {n}" for n in steps_notes
+        ]
     whole = done[0].log if len(done) == 1 else _concatenate([s.log for s in done])
     log = Log(
-        t=whole.t, q=whole.q, tau=whole.tau, qd=whole.qd, qdd=whole.qdd,
-        source=log.source, notes=log.notes + opening + steps_notes,
+        t=whole.t,
+        q=whole.q,
+        tau=whole.tau,
+        qd=whole.qd,
+        qdd=whole.qdd,
+        source=log.source,
+        notes=log.notes + opening + steps_notes,
     )
     spikes = np.concatenate([s.spikes for s in done])
     if reference is not None:
@@ -296,13 +312,15 @@ def _prepare_segment(
         trims.append(("low-pass", edge_trim(butterworth_lowpass(o.order, 2 * o.cutoff / fs))))
     band_limited = o.cutoff is not None and o.cutoff <= sig.ANTIALIAS_FRACTION * fs / (2 * o.factor)
     if o.factor > 1 and not band_limited:
-        trims.append(("anti-alias", edge_trim(butterworth_lowpass(8, sig.ANTIALIAS_FRACTION / o.factor))))
+        trims.append(
+            ("anti-alias", edge_trim(butterworth_lowpass(8, sig.ANTIALIAS_FRACTION / o.factor)))
+        )
     trim = -(-sum(k for _, k in trims) // o.factor) if o.trim else 0  # after decimation
     # sosfiltfilt's extension must be shorter than the signal; the trim must leave 2 samples
     padding = [default_padding(butterworth_lowpass(o.order, 0.5))] if o.cutoff is not None else []
     padding += [default_padding(butterworth_lowpass(8, 0.5))] if o.factor > 1 else []
     needed = max([p + 1 for p in padding] + [o.factor * (2 * trim + 2)])
-    if log.T < needed:
+    if needed > log.T:
         return f"shorter than the {needed} samples its filters and edge trim need"
     spikes: NDArray[np.bool_] = np.zeros(log.T, dtype=bool)
 
@@ -328,7 +346,7 @@ def _prepare_segment(
             f"(sosfiltfilt, fs {fs:.4g} Hz) on {', '.join(names)}",
         )
 
-    # 3. differentiation, of the filtered signals (see prepare_log's docstring for why in this order)
+    # 3. differentiation, of the filtered signals (prepare_log's docstring says why in this order)
     new: dict[str, NDArray] = {}
     if o.differentiate != "never" and log.qd is None:
         new["qd"] = sig.differentiate(log.q, log.t)
