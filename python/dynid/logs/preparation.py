@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -40,9 +41,10 @@ def prepare_log(
 
     0. **Time base** (:mod:`dynid.logs.timing`): the jitter, dropped samples and gaps of ``t``
        are measured and noted whenever a step below is asked for or the grid is irregular.
-       Steps 1, 2 and 4 treat the samples as equally spaced. A gap (a step longer than
-       ``GAP_STEPS`` median steps) splits the log into segments that go through steps 1-4 and 7
-       each on its own (no filter across a gap); the prepared log is their concatenation. A
+       Steps 1, 2 and 4 treat the samples as equally spaced. When one of them runs, a gap (a
+       step longer than ``GAP_STEPS`` median steps) splits the log into segments that go
+       through steps 1-4 and 7 each on its own (no filter across a gap); the prepared log is
+       their concatenation. A
        segment too short for the filter and its edge trim is dropped (noted). When steps 1, 2
        or 4 are asked for and the grid is not uniform (dropped samples, or more than
        ``JITTER_FRACTION`` of the steps off by more than ``JITTER_TOLERANCE``),
@@ -140,7 +142,9 @@ def prepare_log(
         if grid_steps:
             log.check_uniform("prepare_log (filtering, decimation, spike detection)")
     else:
-        parts = segments(log.t, timing.gaps)
+        # Differentiation alone works on the stamps as they are (np.gradient: the parabola
+        # through three neighbours, gaps included), so the log stays whole then, as before.
+        parts = segments(log.t, timing.gaps) if grid_steps else [slice(0, log.T)]
         resample = grid_steps and not timing.uniform
         if resample and nonuniform == "refuse":
             raise ValueError(
@@ -158,7 +162,7 @@ def prepare_log(
         elif not timing.uniform and grid_steps:
             decision = "not uniform, filtered as if uniform (nonuniform='ignore')"
         elif not timing.uniform:
-            decision = "not uniform; differentiated on the time stamps as they are"
+            decision = "not uniform; differentiated on the time stamps as they are, not split"
         else:
             decision = "uniform"
         opening.append(f"{timing.describe()}: {decision}")
@@ -212,7 +216,7 @@ def prepare_log(
     )
     spikes = np.concatenate([s.spikes for s in done])
     if reference is not None:
-        reference = np.concatenate([s.reference for s in done])  # type: ignore[misc]
+        reference = np.concatenate([s.reference for s in done if s.reference is not None])
 
     removals: list[tuple[NDArray[np.bool_], str]] = []  # (rows to drop, why), on the final grid
     if spikes_wanted:
@@ -303,9 +307,9 @@ def _prepare_segment(
         measured = {"tau": log.tau, **({"ref": reference} if reference is not None else {})}
         if grid.size < 4:
             return f"fewer than 4 samples on the uniform grid of {o.step:.4g} s"
-        new = resample_uniform(log.t, grid, smooth, measured)
-        reference = new.pop("ref", None)
-        log = log.replace(t=grid, **new)
+        resampled: dict[str, Any] = resample_uniform(log.t, grid, smooth, measured)
+        reference = resampled.pop("ref", None)
+        log = log.replace(t=grid, **resampled)
     fs = 1.0 / o.step if o.resample else log.fs
     trims = []  # (filter, samples at the original rate)
     if o.cutoff is not None:
@@ -390,7 +394,7 @@ def _prepare_segment(
 
 
 def _concatenate(logs: list[Log]) -> Log:
-    arrays = {
+    arrays: dict[str, Any] = {
         k: np.concatenate([getattr(s, k) for s in logs])
         for k in ("t", *SIGNALS)
         if getattr(logs[0], k) is not None
