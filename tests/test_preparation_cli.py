@@ -130,3 +130,29 @@ def test_validate_applies_the_recorded_preparation(arm, noisy, tmp_path, capsys)
 
     printed, report = validate("v3", "--no-recorded-preparation")
     assert "preparation applied: none" in printed and report["preparation"] == {}
+
+
+def test_identify_reports_the_jitter_and_the_trim(arm, tmp_path, capsys) -> None:
+    """A log stepping 10 ms / 12 ms at random: `dynid identify --cutoff` says what it found and
+    did (resampled, trimmed) in its output and in result.json's notes; --nonuniform refuse
+    is exit 2 with a message saying how to go on."""
+    rng = np.random.default_rng(1)
+    t = np.concatenate([[0.0], np.cumsum(rng.choice([0.010, 0.012], size=900))])
+    w = 2 * np.pi * 0.5
+    q = np.column_stack([np.sin(w * t), np.cos(1.3 * w * t)])
+    qd = np.column_stack([w * np.cos(w * t), -1.3 * w * np.sin(1.3 * w * t)])
+    qdd = np.column_stack([-(w**2) * q[:, 0], -((1.3 * w) ** 2) * q[:, 1]])
+    save_log(Log(t=t, q=q, tau=arm.rnea(q, qd, qdd)), tmp_path / "ur.csv")
+    argv = ["identify", str(tmp_path / "ur.csv"), "--model", "planar_2r", "--friction"]
+    assert main([*argv, "--cutoff", "5", "--output", str(tmp_path / "a")]) == 0
+    printed = capsys.readouterr().out
+    assert "prepared: time stamps: median step" in printed and "jitter max" in printed
+    assert "resampled onto a uniform grid" in printed and "trimmed" in printed
+    notes = json.loads((tmp_path / "a" / "result.json").read_text())["training"]["notes"]
+    assert any("resampled onto a uniform grid" in note for note in notes)
+    assert (
+        main([*argv, "--cutoff", "5", "--nonuniform", "refuse", "--output", str(tmp_path / "b")])
+        == 2
+    )
+    err = capsys.readouterr().err
+    assert "need a uniform grid" in err and "--nonuniform resample" in err
