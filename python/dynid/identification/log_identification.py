@@ -467,7 +467,7 @@ def identify_log(
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
         "notes": list(prepared.notes) + rows_note + block_notes,
-        "metrics": kept_row_metrics(prepared.tau, result.fitted, rows),
+        "metrics": _kept_row_metrics(prepared.tau, result.fitted, rows),
     }
     return result
 
@@ -558,8 +558,10 @@ def run_validation(
     result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
 ) -> LogValidation:
     """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
-    and measure the errors; ``notes`` says where the preparation differs from the training
-    log's (a low-pass on one and not the other biases the comparison)."""
+    and measure the errors (with ``min_velocity``: on the rows of joint j where |qd_j| >=
+    min_velocity, as :func:`identify_log` fits); ``notes`` says which rows were left out and
+    where the preparation differs from the training log's (a low-pass on one and not the other
+    biases the comparison)."""
     options = _options(preparation)
     sample_options = _sample_options(options)
     prepared = prepare_log(log, **sample_options) if sample_options else log
@@ -574,7 +576,7 @@ def run_validation(
             f"{_filtered(options.get('cutoff'))}"
         )
     return LogValidation(
-        prepared, predicted, kept_row_metrics(prepared.tau, predicted, rows), options, notes
+        prepared, predicted, _kept_row_metrics(prepared.tau, predicted, rows), options, notes
     )
 
 
@@ -619,7 +621,7 @@ def _moving_rows(
     return keep, [note]
 
 
-def kept_row_metrics(
+def _kept_row_metrics(
     measured: NDArray[np.float64], predicted: NDArray[np.float64], keep: NDArray[np.bool_] | None
 ) -> dict[str, NDArray[np.float64]]:
     """:func:`error_metrics` per joint on the rows kept (all without ``keep``)."""
