@@ -326,9 +326,10 @@ def identify_log(
     decimate, outlier_k, nonuniform, trim_edges) applied first; qd and qdd are computed from q
     when the log lacks them. ``min_velocity`` (scalar or per joint) leaves out the rows of joint
     j where |qd_j| < min_velocity, not whole samples (joint j's friction is only in its own
-    rows), and the training errors are computed on the rows kept. ``rotor`` adds the Ia columns; ``friction`` the friction model: False ("none"),
-    True or "symmetric" (Fv qd + Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a
-    coefficient per direction of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
+    rows), and the training errors are computed on the rows kept. ``rotor`` adds the Ia
+    columns; ``friction`` the friction model: False ("none"), True or "symmetric" (Fv qd +
+    Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a coefficient per direction
+    of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
     Coulomb asymmetry: :mod:`dynid.identification.friction_models`). ``offset`` adds one constant
     torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
     these two columns are structurally identifiable next to the others
