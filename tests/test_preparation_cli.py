@@ -156,3 +156,14 @@ def test_identify_reports_the_jitter_and_the_trim(arm, tmp_path, capsys) -> None
     )
     err = capsys.readouterr().err
     assert "need a uniform grid" in err and "--nonuniform resample" in err
+
+
+def test_skip_end_on_the_command_line(arm, tmp_path) -> None:
+    log = fourier_log(arm, 1, seconds=4.0)
+    save_log(log, tmp_path / "log.npz")
+    out = tmp_path / "out"
+    argv = ["identify", str(tmp_path / "log.npz"), "--model", "planar_2r", "--friction"]
+    assert main([*argv, "--skip", "5", "--skip-end", "20", "--output", str(out)]) == 0
+    training = json.loads((out / "result.json").read_text())["training"]
+    assert training["samples"] == log.T - 25  # no filter: nothing trimmed
+    assert "skipped the last 20 samples" in training["notes"]
