@@ -109,7 +109,7 @@ def test_preparation_options_reach_the_result(files, tmp_path, capsys):
     }
     notes = " ".join(training["notes"])
     assert "skipped the first 10 samples" in notes and "order-2 Butterworth 8 Hz" in notes
-    assert "|qd| < 0.01" in notes
+    assert "|qd_j| < 0.01" in notes  # rows of the slow joint, not whole samples (issue 20)
     assert "prepared: skipped" not in capsys.readouterr().out  # step 3 lists the new notes only
 
 

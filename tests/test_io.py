@@ -125,7 +125,9 @@ def test_real_log_velocities_agree_with_differentiated_positions() -> None:
     """The README: from sample 200 on, the stored velocities match the derivative of the
     positions to ~6 % RMS. Differentiating and filtering at 3 Hz (prepare_log) agrees so."""
     log = load_log(DATA / "measurements_1.npz")
-    ours = prepare_log(log, cutoff=3.0, differentiate="always")
+    # trim_edges=False: the sample-by-sample comparison needs the whole grid (the edges are
+    # left out below anyway); the default trim is tested in test_preparation_edges.py.
+    ours = prepare_log(log, cutoff=3.0, differentiate="always", trim_edges=False)
     err = np.sqrt(np.mean((ours.qd - log.qd)[200:-200] ** 2, axis=0))
     rms = np.sqrt(np.mean(log.qd[200:-200] ** 2, axis=0))
     assert np.all(err / rms < 0.1), err / rms
@@ -321,17 +323,23 @@ def test_prepare_log_lowpass_same_zero_phase_filter_on_every_signal() -> None:
     )
     out = prepare_log(noisy, cutoff=5.0)
     sos = sp.butter(4, 5.0, fs=FS, output="sos")
+    # Since issue 20 the filter's edge transients are trimmed (test_preparation_edges.py): the
+    # kept samples are scipy's filtered signal without its first and last `trim`.
+    trim = (noisy.T - out.T) // 2
+    assert trim > 0 and f"trimmed {trim} samples" in out.notes[-1]
     for name in ("q", "tau", "qd", "qdd"):
         np.testing.assert_allclose(
-            getattr(out, name), sp.sosfiltfilt(sos, getattr(noisy, name), axis=0), atol=1e-12
+            getattr(out, name),
+            sp.sosfiltfilt(sos, getattr(noisy, name), axis=0)[trim:-trim],
+            atol=1e-12,
         )
     inner = slice(200, -200)  # slow sinusoids (<= 0.3 Hz) pass a 5 Hz zero-phase filter as they are
-    smooth = prepare_log(clean, cutoff=5.0)
+    smooth = prepare_log(clean, cutoff=5.0, trim_edges=False)  # same grid as clean
     for name in ("q", "tau", "qd", "qdd"):
         np.testing.assert_allclose(
             getattr(smooth, name)[inner], getattr(clean, name)[inner], atol=1e-6, err_msg=name
         )
-    assert out.notes[-1] == (
+    assert out.notes[-2] == (
         "low-pass zero-phase order-4 Butterworth 5 Hz (sosfiltfilt, fs 200 Hz) on q, tau, qd, qdd"
     )
 
@@ -346,14 +354,17 @@ def test_prepare_log_paper_eq33_experiment() -> None:
     w = np.pi / 7
     q = np.pi / 2 * np.cos(w * t)[:, None].repeat(7, axis=1)
     log = Log(t, q + rng.normal(0, 1e-4, q.shape), np.zeros_like(q))
-    out = prepare_log(log, cutoff=1.0, order=4)
+    # trim_edges=False: the same grid as t (2 s are left out at each end below; the default
+    # trim, 2.54 s at 1 Hz, is tested in test_preparation_edges.py)
+    out = prepare_log(log, cutoff=1.0, order=4, trim_edges=False)
     inner = slice(400, -400)  # 2 s from each end
     qd = -np.pi / 2 * w * np.sin(w * t)
     qdd = -np.pi / 2 * w**2 * np.cos(w * t)
     assert np.max(np.abs(out.qd[inner] - qd[inner, None])) < 2e-3
     assert np.max(np.abs(out.qdd[inner] - qdd[inner, None])) < 1e-2
-    assert "Butterworth 1 Hz" in out.notes[0]
-    assert out.notes[1] == (
+    assert out.notes[0].startswith("time stamps: median step 0.005 s") and "uniform" in out.notes[0]
+    assert "Butterworth 1 Hz" in out.notes[1]
+    assert out.notes[2] == (
         "qd and qdd computed by second-order central differences on t from low-passed q (twice)"
     )
 
@@ -380,14 +391,14 @@ def test_prepare_log_differentiate_modes() -> None:
 
 def test_prepare_log_decimate() -> None:
     log = sine_log(T=1000)
-    out = prepare_log(log, decimate=4)
+    out = prepare_log(log, decimate=4, trim_edges=False)  # the trim: test_preparation_edges.py
     np.testing.assert_array_equal(out.t, log.t[::4])
     assert out.fs == pytest.approx(FS / 4)
     inner = slice(20, -20)  # the slow sinusoids pass the 20 Hz anti-alias filter unchanged
     np.testing.assert_allclose(out.q[inner], log.q[::4][inner], atol=1e-6)
     assert out.notes[-1].startswith("decimated by 4") and "20 Hz" in out.notes[-1]
     low = prepare_log(log, cutoff=2.0, decimate=4)
-    assert "already band-limited" in low.notes[-1]
+    assert "already band-limited" in low.notes[-2]  # the last: the edge trim (issue 20)
 
 
 def test_prepare_log_drops_slow_samples() -> None:
@@ -426,7 +437,9 @@ def test_prepare_log_outliers_against_a_reference() -> None:
     # Decimated: the reference rows follow the kept samples. The anti-alias filter spreads an
     # outlier over its neighbours, which are then dropped too (they are contaminated), but no
     # sample far from an outlier is.
-    decimated = prepare_log(log, decimate=2, outlier_k=5.0, reference_tau=model)
+    decimated = prepare_log(
+        log, decimate=2, outlier_k=5.0, reference_tau=model, trim_edges=False
+    )  # the whole grid: the edge trim would count as dropped samples here
     grid = np.arange(0, 1200, 2)
     dropped = np.setdiff1d(grid, np.searchsorted(log.t, decimated.t))
     assert set(bad[bad % 2 == 0]) <= set(dropped)
@@ -445,7 +458,9 @@ def test_prepare_log_spikes_without_reference_are_dropped_before_they_spread() -
     spiky = tau.copy()
     bad = np.sort(rng.choice(np.arange(100, 1900), 8, replace=False))
     spiky[bad, 1] += 20.0
-    out = prepare_log(clean.replace(tau=spiky), cutoff=2.0, outlier_k=5.0)
+    # trim_edges=False: the spikes lie 100 samples or more from the ends, inside the 2 Hz
+    # filter's trim of 254; the trim itself is tested in test_preparation_edges.py
+    out = prepare_log(clean.replace(tau=spiky), cutoff=2.0, outlier_k=5.0, trim_edges=False)
     np.testing.assert_array_equal(out.t, np.delete(clean.t, bad))
     reference = np.delete(sig.lowpass(tau, FS, 2.0), bad, axis=0)
     # a 20 N m spike spread by the 2 Hz filter would shift its neighbours by ~0.4 N m
@@ -456,7 +471,9 @@ def test_prepare_log_spikes_without_reference_are_dropped_before_they_spread() -
 def test_prepare_log_steps_are_noted_in_order() -> None:
     log = sine_log(T=2000, derivatives=False)
     out = prepare_log(log, cutoff=4.0, decimate=2, min_velocity=0.05, outlier_k=6.0)
-    assert [note.split()[0] for note in out.notes] == ["low-pass", "qd", "decimated", "dropped"]
+    # since issue 20: the time base first, the edge trim after the decimation
+    steps = ["time", "low-pass", "qd", "decimated", "trimmed", "dropped"]
+    assert [note.split()[0] for note in out.notes] == steps
 
 
 @pytest.mark.parametrize(
@@ -483,7 +500,12 @@ def test_prepare_log_rejects_bad_arguments(kwargs: dict, match: str) -> None:
 def test_prepare_log_refuses_to_filter_a_log_with_gaps() -> None:
     log = sine_log(T=500)
     gappy = log.select(np.r_[np.arange(200), np.arange(300, 500)])
+    # Filtering as if uniform (the behaviour before issue 20) still refuses a gap ...
     with pytest.raises(ValueError, match=r"t: .* gap of 0.505 s .* after sample 199"):
+        prepare_log(gappy, cutoff=5.0, nonuniform="ignore")
+    # ... by default the log is split there (test_preparation_timing.py), and segments of 200
+    # samples are too short for a 5 Hz filter's edge trim at both ends (2 x 102 samples)
+    with pytest.raises(ValueError, match=r"no segment long enough .* 2 segments of 200, 200"):
         prepare_log(gappy, cutoff=5.0)
     prepare_log(gappy, min_velocity=0.01)  # selection alone is fine
 

@@ -33,6 +33,7 @@ def log_options(args: argparse.Namespace, joint_names: Any = None) -> dict[str, 
         "current": getattr(args, "current", False),
         "drop_nonfinite": args.drop_nonfinite,
         "sample_time": getattr(args, "sample_time", None),
+        "skip_end": getattr(args, "skip_end", 0) or 0,
         **ros_bag_options(args, joint_names),
     }
 
@@ -83,15 +84,42 @@ def to_joint_side(args: argparse.Namespace, log: Any, robot: Any) -> Any:
     return joint_log
 
 
+#: prepare_log options and the command-line flags that set them.
+PREPARATION_FLAGS = {
+    "cutoff": "cutoff",
+    "order": "order",
+    "decimate": "decimate",
+    "min_velocity": "min_velocity",
+    "outlier_k": "outliers",
+    "nonuniform": "nonuniform",
+    "trim_edges": "edge_trim",
+}
+
+
+def given_preparation(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``prepare_log`` options given on the command line (nothing for those left out)."""
+    given = {
+        key: getattr(args, flag)
+        for key, flag in PREPARATION_FLAGS.items()
+        if getattr(args, flag, None) is not None
+    }
+    if "order" in given and "cutoff" not in given:
+        given.pop("order")  # the order of a low-pass that is not asked for
+    return given
+
+
 def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
-    """The ``prepare_log`` options given on the command line."""
-    options: dict[str, Any] = {"cutoff": args.cutoff, "decimate": args.decimate}
-    if args.cutoff is not None:
-        options["order"] = args.order
-    for key, option in (("min_velocity", "min_velocity"), ("outlier_k", "outliers")):
-        if getattr(args, option, None) is not None:
-            options[key] = getattr(args, option)
-    return {k: v for k, v in options.items() if v is not None and not (k == "decimate" and v == 1)}
+    """The ``prepare_log`` options given on the command line, defaults left out (the order 4 of
+    a --cutoff made explicit)."""
+    options = given_preparation(args)
+    if "cutoff" in options:
+        options.setdefault("order", 4)
+    return _without_defaults(options)
+
+
+def _without_defaults(options: dict[str, Any]) -> dict[str, Any]:
+    defaults = {"decimate": 1, "nonuniform": "resample", "trim_edges": True}
+    return {k: v for k, v in options.items() if not (k in defaults and v == defaults[k])}
 
 
 def demo(args: argparse.Namespace) -> None:
@@ -238,13 +266,18 @@ def validate(args: argparse.Namespace) -> None:
             "holds currents",
             flush=True,
         )
-    validation = run_validation(result, log, preparation=preparation_options(args))
+    options, sources = validation_preparation(result, args)
+    validation = run_validation(result, log, preparation=options)
     step(
         f"result {args.result} ({result.model.get('name')}, {result.theta.size} coefficients); "
         f"log {args.log} ({log_reading(log)}): {validation.log.T} samples"
     )
+    print(f"preparation applied: {sources}", flush=True)
+    new_notes = validation.log.notes[len(log.notes) :]
+    if new_notes:
+        print("prepared: " + "; ".join(new_notes), flush=True)
     for note in validation.notes:
-        print(f"note: {note} (--cutoff)", flush=True)
+        print(f"note: {note}", flush=True)
     step("predicted the torques")
     print(
         validation_table(
@@ -260,6 +293,37 @@ def validate(args: argparse.Namespace) -> None:
         overwrite=args.overwrite,
     )
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+
+
+def validation_preparation(result: Any, args: argparse.Namespace) -> tuple[dict[str, Any], str]:
+    """The preparation of ``dynid validate``: the training log's, as recorded in the result
+    (``training.preparation``), unless --no-recorded-preparation; each option given on the
+    command line replaces the recorded one. Returns the options and, in words, where each came
+    from."""
+    recorded: dict[str, Any] = {}
+    if args.recorded_preparation:
+        recorded = dict(result.training.get("preparation", {}))
+        recorded.pop("reference_tau", None)  # a torque of the training log: no use here
+    given = given_preparation(args)
+    options = {**recorded, **given}
+    if "cutoff" in options:
+        options.setdefault("order", 4)
+    options = _without_defaults(options)
+    if not options:
+        return options, "none (the log as given, qd and qdd differentiated when missing)"
+    flags = {k: f"--{f.replace('_', '-')}" for k, f in PREPARATION_FLAGS.items()}
+    flags["trim_edges"] = "--edge-trim"
+
+    def flag(key: str, value: Any) -> str:
+        if key == "trim_edges":
+            return "--edge-trim" if value else "--no-edge-trim"
+        return f"{flags[key]} {value}"
+
+    words = [
+        flag(k, v) + (" (command line)" if k in given else " (recorded in the result)")
+        for k, v in options.items()
+    ]
+    return options, ", ".join(words)
 
 
 def export(args: argparse.Namespace) -> None:

@@ -97,15 +97,6 @@ def _add_identify(subcommands: Any) -> None:
     _add_current(p)
     _add_preparation(p)
     _add_motor_side(p)
-    p.add_argument(
-        "--min-velocity",
-        type=float,
-        metavar="V",
-        help="drop samples where some joint has |qd| < V (friction near zero speed)",
-    )
-    p.add_argument(
-        "--outliers", type=float, metavar="K", help="drop torque spikes beyond K robust sigmas"
-    )
     _add_output(p, "dynid-identify")
     p.set_defaults(run=commands.identify)
 
@@ -127,6 +118,13 @@ def _add_validate(subcommands: Any) -> None:
     )
     _add_preparation(p)
     _add_motor_side(p)
+    p.add_argument(
+        "--recorded-preparation",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="apply the preparation recorded in the result (the training log's), each option "
+        "given here replacing the recorded one (default: on)",
+    )
     _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
 
@@ -262,6 +260,13 @@ def _add_log_reading(p: argparse.ArgumentParser) -> None:
         help="drop the first N samples (start-up transient)",
     )
     p.add_argument(
+        "--skip-end",
+        type=int,
+        default=0,
+        metavar="N",
+        help="drop the last N samples (the filters' edge transients are trimmed anyway)",
+    )
+    p.add_argument(
         "--columns",
         metavar="MAP",
         help="columns/keys of a foreign log, e.g. 't=stamp,q=pos_*,tau=effort_*' "
@@ -316,5 +321,35 @@ def _add_preparation(p: argparse.ArgumentParser) -> None:
         metavar="HZ",
         help="zero-phase Butterworth low-pass of q, qd, qdd, tau at HZ",
     )
-    p.add_argument("--order", type=int, default=4, help="order of that filter (default 4)")
-    p.add_argument("--decimate", type=int, default=1, metavar="K", help="keep every K-th sample")
+    # Defaults None (applied in commands.preparation_options), so that `dynid validate` can
+    # tell an option given on its command line from one to take from the result.
+    p.add_argument("--order", type=int, help="order of that filter (default 4)")
+    p.add_argument("--decimate", type=int, metavar="K", help="keep every K-th sample")
+    _add_preparation_checks(p)
+
+
+def _add_preparation_checks(p: argparse.ArgumentParser) -> None:
+    """The prepare_log options against silent degradation (issue 20, item 2), and the row
+    selection of identify and validate."""
+    p.add_argument(
+        "--min-velocity",
+        type=float,
+        metavar="V",
+        help="leave out the rows of joint j where |qd_j| < V (friction near zero speed); "
+        "the errors are reported on the rows kept",
+    )
+    p.add_argument(
+        "--outliers", type=float, metavar="K", help="drop torque spikes beyond K robust sigmas"
+    )
+    p.add_argument(
+        "--nonuniform",
+        choices=("resample", "refuse", "ignore"),
+        help="time stamps with jitter or dropped samples, before filtering: resample onto a "
+        "uniform grid (default), refuse, or filter as if uniform (docs/data.md)",
+    )
+    p.add_argument(
+        "--edge-trim",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="drop the filters' edge transients at both ends of every segment (default: on)",
+    )

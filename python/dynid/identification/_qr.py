@@ -30,13 +30,16 @@ class GroupedTriangularFactors:
     """The R factors of [A_j | b_j] of each joint j of ``joints``, in scaled units.
 
     ``add`` takes the regressor of T samples (T, n, p) and their torques (T, n) (finite, already
-    checked); joint j's rows are Y[:, j, :] and tau[:, j] (the stacking of ``stack_by_joint``).
+    checked); joint j's rows are Y[:, j, :] and tau[:, j] (the stacking of ``stack_by_joint``),
+    those where ``keep[:, j]`` is True when a (T, n) row mask is given (e.g. joint j moving:
+    ``--min-velocity``); ``counts`` holds the rows of each joint.
     """
 
     def __init__(self, n: int, p: int, joints: tuple[int, ...]) -> None:
         self.n, self.p, self.joints = n, p, joints
         self.factors: dict[int, NDArray[np.float64]] = {j: np.zeros((0, p + 1)) for j in joints}
         self.samples = 0
+        self.counts: dict[int, int] = dict.fromkeys(joints, 0)
         self.a_exp: int | None = None  # scaled A = A / 2^a_exp
         self.b_exp: int | None = None
         self.max_a = 0.0
@@ -44,12 +47,20 @@ class GroupedTriangularFactors:
 
     @property
     def rows(self) -> int:
-        return self.samples * len(self.joints)
+        return sum(self.counts.values())
 
-    def add(self, Y: NDArray[np.float64], tau: NDArray[np.float64]) -> None:
+    def add(
+        self,
+        Y: NDArray[np.float64],
+        tau: NDArray[np.float64],
+        keep: NDArray[np.bool_] | None = None,
+    ) -> None:
         T = Y.shape[0]
         if T == 0:
             return
+        if keep is not None:  # only the rows kept count for the scaling, as for the fit
+            Y = np.where(keep[:, :, None], Y, 0.0)
+            tau = np.where(keep, tau, 0.0)
         kept = list(self.joints)
         every = len(kept) == self.n
         largest_a = (
@@ -68,13 +79,16 @@ class GroupedTriangularFactors:
         for lo in range(0, T, SUB_BLOCK):
             hi = min(T, lo + SUB_BLOCK)
             for j in kept:
+                rows = slice(lo, hi) if keep is None else lo + np.flatnonzero(keep[lo:hi, j])
+                count = hi - lo if keep is None else rows.size  # type: ignore[union-attr]
                 old = self.factors[j]
                 r0 = old.shape[0]
-                block = np.empty((r0 + hi - lo, p + 1), order="F")  # LAPACK's order: no copy
+                block = np.empty((r0 + count, p + 1), order="F")  # LAPACK's order: no copy
                 block[:r0] = old
-                np.multiply(Y[lo:hi, j, :], a_factor, out=block[r0:, :p])
-                np.multiply(tau[lo:hi, j], b_factor, out=block[r0:, p])
+                np.multiply(Y[rows, j, :], a_factor, out=block[r0:, :p])
+                np.multiply(tau[rows, j], b_factor, out=block[r0:, p])
                 self.factors[j] = upper_triangle(block)
+                self.counts[j] += count
         self.samples += T
 
     def _rescale(self, a_new: int | None, b_new: int | None) -> None:
@@ -106,6 +120,7 @@ class GroupedTriangularFactors:
         whole.a_exp = max((f.a_exp for f in parts if f.a_exp is not None), default=None)
         whole.b_exp = max((f.b_exp for f in parts if f.b_exp is not None), default=None)
         whole.samples = sum(f.samples for f in parts)
+        whole.counts = {j: sum(f.counts[j] for f in parts) for j in first.joints}
         whole.max_a = max(f.max_a for f in parts)
         whole.max_b = max(f.max_b for f in parts)
         p = first.p

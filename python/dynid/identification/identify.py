@@ -224,7 +224,7 @@ def solve_factors(
             f"(the lecture asks for N >> p): use more samples"
         )
     joints = np.array(factors.joints, dtype=np.int64)
-    counts = np.full(joints.size, factors.samples)
+    counts = np.array([factors.counts[j] for j in factors.joints], dtype=float)
     # Factors are in units where max |A| and max |b| are in [0.5, 1) (_qr.py): squares and norms
     # of values near the float64 limits would overflow, tiny ones underflow. Everything is
     # scaled back at the end.

@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._equality import ValueEquality
+from ..logs import signal as sig
 from ..logs.log_files import Log
 from ..logs.preparation import prepare_log
 from ..model.base_parameters import base_parameters
@@ -84,6 +85,8 @@ PREPARATION = (
     "min_velocity",
     "outlier_k",
     "reference_tau",
+    "nonuniform",
+    "trim_edges",
 )
 
 
@@ -320,10 +323,13 @@ def identify_log(
     """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
 
     ``preparation``: options of :func:`dynid.prepare_log` (cutoff, order, differentiate,
-    decimate, min_velocity, outlier_k) applied first; qd and qdd are computed from q when the log
-    lacks them. ``rotor`` adds the Ia columns; ``friction`` the friction model: False ("none"),
-    True or "symmetric" (Fv qd + Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a
-    coefficient per direction of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
+    decimate, outlier_k, nonuniform, trim_edges) applied first; qd and qdd are computed from q
+    when the log lacks them. ``min_velocity`` (scalar or per joint) leaves out the rows of joint
+    j where |qd_j| < min_velocity, not whole samples (joint j's friction is only in its own
+    rows), and the training errors are computed on the rows kept. ``rotor`` adds the Ia
+    columns; ``friction`` the friction model: False ("none"), True or "symmetric" (Fv qd +
+    Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a coefficient per direction
+    of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
     Coulomb asymmetry: :mod:`dynid.identification.friction_models`). ``offset`` adds one constant
     torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
     these two columns are structurally identifiable next to the others
@@ -369,9 +375,10 @@ def identify_log(
     built = build_blocks(context)  # in column order (dynid.identification.blocks.registry)
     block_notes = [note for block in built for note in block.notes()]
     blocks = kept(built)
-    prepared = _with_derivatives(prepare_log(log, **options), robot.n, robot.name)
+    prepared = _with_derivatives(prepare_log(log, **_sample_options(options)), robot.n, robot.name)
     qd, qdd = prepared.qd, prepared.qdd
     assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
+    rows, rows_note = _moving_rows(qd, options.get("min_velocity"))
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
     names, expressions = list(base.names), list(base.expressions)
     for block in blocks:
@@ -414,6 +421,8 @@ def identify_log(
             ],
             axis=2,
         )
+        if rows is not None:  # a zero row adds nothing to the least-squares objective
+            standard = np.where(rows[:, :, None], standard, 0.0)
         selected = np.concatenate(
             [base.independent, np.arange(len(base.parameter_names), standard.shape[2])]
         )
@@ -430,7 +439,7 @@ def identify_log(
         Y = chunk_regressor(c)
         if keep:
             cache[i] = Y
-        accumulator.add(Y, prepared.tau[c])
+        accumulator.add(Y, prepared.tau[c], None if rows is None else rows[c])
     # The physical fit needs the least squares only for the rank, the condition number and the
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
@@ -442,8 +451,9 @@ def identify_log(
     result.covariance = fit.covariance
     result.excluded = fit.excluded
     if standard is not None:
+        tau = prepared.tau if rows is None else np.where(rows, prepared.tau, 0.0)
         _physical(
-            result, standard, prepared, fit.noise_variance, prior_robot, prior_weight or 0.0, prior
+            result, standard, tau, fit.noise_variance, prior_robot, prior_weight or 0.0, prior
         )
     result.fitted = np.concatenate(
         [
@@ -458,8 +468,8 @@ def identify_log(
         "duration_s": prepared.duration,
         "sampling_rate_hz": prepared.fs,
         "preparation": {k: _plain(v) for k, v in options.items()},
-        "notes": list(prepared.notes) + block_notes,
-        "metrics": error_metrics(prepared.tau, result.fitted),
+        "notes": list(prepared.notes) + rows_note + block_notes,
+        "metrics": _kept_row_metrics(prepared.tau, result.fitted, rows),
     }
     return result
 
@@ -467,14 +477,15 @@ def identify_log(
 def _physical(
     result: LogIdentification,
     Y: NDArray[np.float64],
-    log: Log,
+    tau: NDArray[np.float64],
     noise_variance: NDArray[np.float64],
     prior: Robot | None,
     prior_weight: float,
     source: Any,
 ) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one; ``Y``
-    (T, n, P + e) is the standard regressor of ``log`` followed by the blocks' columns."""
+    (T, n, P + e) is the standard regressor of the log followed by the blocks' columns, ``tau``
+    (T, n) its torques (the rows left out are zero in both)."""
     robot, n = result.robot, result.n
     model = result.identification_model
     # Each block says which of its coefficients are >= 0 (friction dissipates, as Fv, Fs >= 0).
@@ -489,7 +500,7 @@ def _physical(
     fit = physical_least_squares(
         robot,
         Y,
-        log.tau,
+        tau,
         rotor=result.rotor,
         friction=result.friction,
         weights=weights,
@@ -549,12 +560,17 @@ def run_validation(
     result: LogIdentification, log: Log, *, preparation: Mapping[str, Any] | None = None
 ) -> LogValidation:
     """Prepare ``log`` (``prepare_log(log, **preparation)``), predict its torques with ``result``
-    and measure the errors; ``notes`` says where the preparation differs from the training
-    log's (a low-pass on one and not the other biases the comparison)."""
+    and measure the errors (with ``min_velocity``: on the rows of joint j where |qd_j| >=
+    min_velocity, as :func:`identify_log` fits); ``notes`` says which rows were left out and
+    where the preparation differs from the training log's (a low-pass on one and not the other
+    biases the comparison)."""
     options = _options(preparation)
-    prepared = prepare_log(log, **options) if options else log
+    sample_options = _sample_options(options)
+    prepared = prepare_log(log, **sample_options) if sample_options else log
     predicted = result.predict(prepared)
-    notes = []
+    qd = prepared.qd if prepared.qd is not None else _with_derivatives(prepared, result.n, "").qd
+    rows, rows_note = _moving_rows(qd, options.get("min_velocity"))
+    notes = list(rows_note)
     trained = result.training.get("preparation", {}).get("cutoff")
     if trained != options.get("cutoff"):
         notes.append(
@@ -562,7 +578,7 @@ def run_validation(
             f"{_filtered(options.get('cutoff'))}"
         )
     return LogValidation(
-        prepared, predicted, error_metrics(prepared.tau, predicted), options, notes
+        prepared, predicted, _kept_row_metrics(prepared.tau, predicted, rows), options, notes
     )
 
 
@@ -573,6 +589,51 @@ def validate_log(
     first): ``rms``, ``relative_rms`` (rms error / rms of the measured torque), ``max_abs``,
     ``r2`` and ``mse`` (see :func:`dynid.identification.validation.error_metrics`)."""
     return run_validation(result, log, preparation=preparation).metrics
+
+
+def _sample_options(options: dict[str, Any]) -> dict[str, Any]:
+    """The prepare_log options without min_velocity: identify and validate leave out rows of
+    the stacked system per joint (:func:`_moving_rows`), not whole samples."""
+    return {k: v for k, v in options.items() if k != "min_velocity"}
+
+
+def _moving_rows(
+    qd: NDArray[np.float64] | None, min_velocity: Any
+) -> tuple[NDArray[np.bool_] | None, list[str]]:
+    """(T, n) the rows of joint j kept by ``min_velocity`` (|qd_j| >= v_j), and a note; (None,
+    []) without it. Lecture, "further practical hints": data near zero velocity are discarded
+    because sign(qd) in Fs sign(qd) is ill-defined there; joint j's friction appears only in
+    joint j's rows, so a slow joint 3 says nothing against joint 1's rows of the same sample."""
+    if min_velocity is None:
+        return None, []
+    assert qd is not None  # identify and validate always have qd (given or differentiated)
+    keep = sig.moving_mask_min_velocity(qd, min_velocity, per_joint=True)
+    left = ", ".join(f"{int((~keep[:, j]).sum())}" for j in range(keep.shape[1]))
+    if not keep.any(axis=0).all():
+        idle = [j + 1 for j in range(keep.shape[1]) if not keep[:, j].any()]
+        raise ValueError(
+            f"min_velocity: no row of joint(s) {idle} has |qd| >= "
+            f"{np.round(np.asarray(min_velocity), 6)}"
+        )
+    note = (
+        f"left out the rows of joint j where |qd_j| < {np.round(np.asarray(min_velocity), 6)} "
+        f"(friction sign ill-defined near zero velocity): {left} of {keep.shape[0]} rows per "
+        "joint; the errors are on the rows kept"
+    )
+    return keep, [note]
+
+
+def _kept_row_metrics(
+    measured: NDArray[np.float64], predicted: NDArray[np.float64], keep: NDArray[np.bool_] | None
+) -> dict[str, NDArray[np.float64]]:
+    """:func:`error_metrics` per joint on the rows kept (all without ``keep``)."""
+    if keep is None:
+        return error_metrics(measured, predicted)
+    per_joint = [
+        error_metrics(measured[keep[:, j], j : j + 1], predicted[keep[:, j], j : j + 1])
+        for j in range(measured.shape[1])
+    ]
+    return {k: np.concatenate([m[k] for m in per_joint]) for k in per_joint[0]}
 
 
 def _filtered(cutoff: float | None) -> str:

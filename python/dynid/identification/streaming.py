@@ -54,15 +54,24 @@ class LeastSquaresAccumulator:
         return self._factors.samples
 
     @blas_single_threaded
-    def add(self, Y: ArrayLike, tau: ArrayLike) -> None:
-        """Adds T samples: Y (T, n, p) or (n, p) for one, tau (T, n) or (n,); finite values."""
+    def add(self, Y: ArrayLike, tau: ArrayLike, keep: ArrayLike | None = None) -> None:
+        """Adds T samples: Y (T, n, p) or (n, p) for one, tau (T, n) or (n,); finite values.
+        ``keep`` (T, n) booleans: only the rows of joint j where ``keep[:, j]`` is True (e.g.
+        the moving ones, ``dynid.logs.signal.moving_mask_min_velocity(per_joint=True)``)."""
         Y3, tau2 = _samples(Y, tau)
         expected = (self._factors.n, self._factors.p)
         if Y3.shape[1:] != expected:
             raise ValueError(
                 f"Y: expected shape (T, {expected[0]}, {expected[1]}), got {np.shape(Y)}"
             )
-        self._factors.add(Y3, tau2)
+        mask = None
+        if keep is not None:
+            mask = np.asarray(keep)
+            if mask.dtype != bool or mask.shape != tau2.shape:
+                raise ValueError(
+                    f"keep: expected booleans of shape {tau2.shape}, got {mask.dtype} {mask.shape}"
+                )
+        self._factors.add(Y3, tau2, mask)
 
     @blas_single_threaded
     def solve(

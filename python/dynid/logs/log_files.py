@@ -224,13 +224,15 @@ def load_log(
     topic: str | None = None,
     joint_names: Sequence[str] | None = None,
     sample_time: float | None = None,
+    skip_end: int = 0,
 ) -> Log:
     """Load a log in any registered format (``dynid.logs.formats``; docs/data.md): dynid's NPZ
     and CSV, UR RTDE, libfranka, pyfri/FRI, any CSV, MATLAB. The format is chosen by the suffix
     and the file's header and named in ``Log.format``.
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
-    the LWR4+ logs skips 500). ``columns`` maps signals of a foreign log to its columns or keys
+    the LWR4+ logs skips 500); ``skip_end`` drops the last samples (e.g. a final rest; the
+    filters' edge transients are trimmed by :func:`dynid.prepare_log` itself). ``columns`` maps signals of a foreign log to its columns or keys
     (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.logs.columns`; a CSV
     without a header by column index, ``{"t": "0", "q": "1:8", "tau": "15:22"}``) and
     ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads the
@@ -251,6 +253,7 @@ def load_log(
     if not path.exists():  # a folder is a log too where a format reads one (ROS 2 bags)
         raise FileNotFoundError(f"path: no such file: {path}")
     skip = count(skip, "skip", 0)
+    skip_end = count(skip_end, "skip_end", 0)
     if time_unit is not None:
         time_scale(time_unit)  # checked before the file is read
     if topic is not None and (not isinstance(topic, str) or not topic):
@@ -283,6 +286,12 @@ def load_log(
         if skip > log.T - 2:
             raise ValueError(f"skip: {skip} leaves fewer than 2 of the {log.T} samples of {path}")
         log = log.slice(skip, None, note=f"skipped the first {skip} samples")
+    if skip_end:
+        if skip_end > log.T - 2:
+            raise ValueError(
+                f"skip_end: {skip_end} leaves fewer than 2 of the {log.T} samples of {path}"
+            )
+        log = log.slice(0, log.T - skip_end, note=f"skipped the last {skip_end} samples")
     check_plausible(log, path.name, unit_given=time_unit is not None)
     return log
 
