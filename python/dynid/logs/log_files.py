@@ -232,7 +232,8 @@ def load_log(
 
     ``skip`` drops the first samples (e.g. a start-up transient; FloBaRoID's configuration for
     the LWR4+ logs skips 500); ``skip_end`` drops the last samples (e.g. a final rest; the
-    filters' edge transients are trimmed by :func:`dynid.prepare_log` itself). ``columns`` maps signals of a foreign log to its columns or keys
+    filters' edge transients are trimmed by :func:`dynid.prepare_log` itself). ``columns`` maps
+    signals of a foreign log to its columns or keys
     (``{"t": "stamp", "q": "pos_*", "tau": "effort_*"}``, :mod:`dynid.logs.columns`; a CSV
     without a header by column index, ``{"t": "0", "q": "1:8", "tau": "15:22"}``) and
     ``time_unit`` ("s", "ms", "us", "ns") says what the time stamps count; None reads the
