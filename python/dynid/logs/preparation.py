@@ -212,6 +212,7 @@ def prepare_log(
         qd=whole.qd,
         qdd=whole.qdd,
         source=log.source,
+        format=log.format,
         notes=log.notes + opening + steps_notes,
     )
     spikes = np.concatenate([s.spikes for s in done])
