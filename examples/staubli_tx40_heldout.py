@@ -50,7 +50,17 @@ COLUMNS = {"q": "motor_position", "tau": "motor_torque"}
 TRAIN, HELD_OUT, SCORED = (0, 24750), (29250, 45000), (29270, 44980)
 FACTOR = 10  # the README's decimation of the target
 REST = 1e-12  # |qd| below this is rounding noise of a constant (filtered) angle
-OPTIONS = ["--rotor", "--friction", "--offset", "--cutoff", "100", "--decimate", "10"]
+OPTIONS = [
+    "--rotor",
+    "--friction",
+    "--offset",
+    "--cutoff",
+    "100",
+    "--decimate",
+    "10",
+    "--rest-velocity",
+    "auto",
+]
 
 
 def relative_rms(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:

@@ -93,6 +93,7 @@ PREPARATION_FLAGS = {
     "outlier_k": "outliers",
     "nonuniform": "nonuniform",
     "trim_edges": "edge_trim",
+    "rest_velocity": "rest_velocity",
 }
 
 

@@ -312,6 +312,16 @@ def _add_motor_side(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _velocity_or_auto(text: str) -> float | str:
+    """--rest-velocity: a number or 'auto'."""
+    if text == "auto":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a velocity or 'auto', got {text!r}") from None
+
+
 def _add_preparation(p: argparse.ArgumentParser) -> None:
     """Reading the log, then the options of prepare_log (commands.preparation_options)."""
     _add_log_reading(p)
@@ -340,6 +350,14 @@ def _add_preparation_checks(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--outliers", type=float, metavar="K", help="drop torque spikes beyond K robust sigmas"
+    )
+    p.add_argument(
+        "--rest-velocity",
+        type=_velocity_or_auto,
+        metavar="V|auto",
+        help="joints at rest: qd_j = 0 where |qd_j| < V (rad/s), so that the Coulomb friction "
+        "there is 0, not +-Fs at random; 'auto': one encoder count at the filter's cutoff "
+        '(docs/data.md, "Joints at rest")',
     )
     p.add_argument(
         "--nonuniform",

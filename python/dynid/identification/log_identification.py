@@ -78,6 +78,7 @@ REGRESSOR_CACHE_BYTES = 1 << 29
 
 #: The options of dynid.prepare_log that ``preparation`` may hold.
 PREPARATION = (
+    "rest_velocity",
     "cutoff",
     "order",
     "differentiate",

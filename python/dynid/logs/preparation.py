@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._checks import positive, positive_int, real_array
+from . import rest
 from . import signal as sig
 from ._iir import butterworth_lowpass, default_padding
 from .edges import EDGE_FRACTION, edge_trim
@@ -34,6 +35,7 @@ def prepare_log(
     reference_tau: ArrayLike | Callable[[Log], ArrayLike] | None = None,
     nonuniform: str = "resample",
     trim_edges: bool = True,
+    rest_velocity: float | str | ArrayLike | None = None,
 ) -> Log:
     """Signal processing for identification; each step only when asked, each noted in ``notes``.
 
@@ -106,6 +108,9 @@ def prepare_log(
         raise ValueError(
             f"nonuniform: expected one of {', '.join(map(repr, NONUNIFORM))}, got {nonuniform!r}"
         )
+    positions, fs_read = log.q, log.fs  # as read: the quantum of rest_velocity="auto"
+    if rest_velocity is not None and log.qd is None and differentiate == "never":
+        raise ValueError("rest_velocity: needs qd, but the log has none and differentiate='never'")
     if not isinstance(trim_edges, (bool, np.bool_)):
         raise ValueError(f"trim_edges: expected True or False, got {trim_edges!r}")
     factor = positive_int(decimate, "decimate")
@@ -218,6 +223,23 @@ def prepare_log(
     spikes = np.concatenate([s.spikes for s in done])
     if reference is not None:
         reference = np.concatenate([s.reference for s in done if s.reference is not None])
+
+    # Joints at rest: qd_j = 0 where |qd_j| is below the rest velocity (dynid.logs.rest).
+    if rest_velocity is not None and log.qd is not None:
+        # the low-pass the velocities went through: the cutoff, or decimation's anti-alias one
+        low_pass = (
+            cutoff if cutoff is not None else (0.4 * fs_read / factor if factor > 1 else None)
+        )
+        velocity = rest.rest_velocity(rest_velocity, positions, fs_read, low_pass)
+        still = rest.at_rest(log.qd, velocity)
+        if still.any():
+            counts = ", ".join(str(int(c)) for c in still.sum(axis=0))
+            log = log.replace(
+                qd=np.where(still, 0.0, log.qd),
+                note=f"joints at rest: qd_j = 0 where |qd_j| < {np.round(velocity, 8).tolist()} "
+                f"rad/s ({'estimated, ' if isinstance(rest_velocity, str) else ''}"
+                f"rest_velocity); samples per joint: {counts}",
+            )
 
     removals: list[tuple[NDArray[np.bool_], str]] = []  # (rows to drop, why), on the final grid
     if spikes_wanted:
