@@ -316,3 +316,18 @@ def test_libfranka_time_unit_given_overrides_its_milliseconds(tmp_path: Path, pa
     with pytest.warns(UserWarning, match="implausible"):  # ms read as us: 1 MHz
         given = load_log(path, time_unit="us")
     np.testing.assert_allclose(given.t, default.t * 1e-3, rtol=1e-15, atol=0)
+
+
+def test_repeated_time_stamps_keep_the_later_sample(tmp_path: Path):
+    """A recorder that wrote a stamp twice: the earlier of the two samples is dropped (noted);
+    time running backwards is still an error naming the line."""
+    path = tmp_path / "log.csv"
+    path.write_text("t,q1,tau1\n0.00,0.0,1\n0.01,0.1,2\n0.01,0.2,3\n0.02,0.3,4\n0.03,0.4,5\n")
+    log = load_log(path)
+    np.testing.assert_array_equal(log.t, [0.0, 0.01, 0.02, 0.03])
+    np.testing.assert_array_equal(log.q[:, 0], [0.0, 0.2, 0.3, 0.4])
+    assert "dropped 1 of 5 samples whose time stamp the next sample repeats" in " ".join(log.notes)
+    assert "line 4" in " ".join(log.notes)
+    path.write_text("t,q1,tau1\n0.00,0.0,1\n0.02,0.1,2\n0.01,0.2,3\n")
+    with pytest.raises(ValueError, match="t: not strictly increasing at line 4"):
+        load_log(path)

@@ -186,6 +186,22 @@ def finish(
                 f"dropped {int(bad.sum())} of {T} rows with non-finite values (the first at "
                 f"{where}; drop_nonfinite)"
             )
+    t = np.asarray(arrays["t"], dtype=float)
+    repeated = np.nonzero(np.diff(t) == 0)[0]  # sample k+1 has the stamp of sample k
+    if repeated.size:
+        # A recorder that wrote a sample twice, or a clock that did not advance: the earlier of
+        # two samples with one stamp is dropped (the later holds the newer values), and the
+        # grid is then measured as any other (prepare_log resamples a non-uniform one).
+        keep = np.ones(len(t), dtype=bool)
+        keep[repeated] = False
+        first = int(repeated[0])
+        where = f"line {lines[first + 1]}" if lines is not None else f"row {first + 1}"
+        arrays = {name: np.asarray(a)[keep] for name, a in arrays.items()}
+        lines = lines[keep] if lines is not None else None
+        added.append(
+            f"dropped {repeated.size} of {len(t)} samples whose time stamp the next sample "
+            f"repeats (the first at {where}; the later sample of each pair kept)"
+        )
     if lines is not None:
         _check_rows(arrays["t"], lines)
     unit = options.time_unit or unit
