@@ -192,7 +192,7 @@ def finish(
         # A recorder that wrote a sample twice, or a clock that did not advance: the earlier of
         # two samples with one stamp is dropped (the later holds the newer values), and the
         # grid is then measured as any other (prepare_log resamples a non-uniform one).
-        keep = np.ones(len(t), dtype=bool)
+        keep: NDArray[np.bool_] = np.ones(len(t), dtype=bool)
         keep[repeated] = False
         first = int(repeated[0])
         where = f"line {lines[first + 1]}" if lines is not None else f"row {first + 1}"
