@@ -261,10 +261,13 @@ def test_identify_and_validate_a_motor_side_log(tmp_path, capsys) -> None:
     assert main([*argv, "--columns", columns, "--output", str(check)]) == 0
     report = json.loads((check / "validation.json").read_text())
     assert max(report["metrics"]["relative_rms"]) < 1e-9
-    # Without --motor-side the same log is read as joint angles: a poor fit, no silent success.
+    # Without --motor-side the result's record applies it (as the recorded preparation): the
+    # same log read as joint angles would be a poor fit that nothing flags.
+    capsys.readouterr()
     assert main([*argv[:3], "--columns", columns, "--output", str(tmp_path / "v2")]) == 0
+    assert "note: --motor-side (recorded in the result)" in capsys.readouterr().out
     report = json.loads((tmp_path / "v2" / "validation.json").read_text())
-    assert min(report["metrics"]["relative_rms"]) > 0.01
+    assert max(report["metrics"]["relative_rms"]) < 1e-9
 
 
 def test_motor_side_errors_exit_2(tmp_path, capsys) -> None:

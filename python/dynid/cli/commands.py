@@ -181,6 +181,8 @@ def identify(args: argparse.Namespace) -> None:
     step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
     print(result.summary(), flush=True)
+    if getattr(args, "motor_side", False):  # validate maps its log the same way
+        result.training["motor_side"] = True
     path = save_result(result, args.output, overwrite=args.overwrite, inputs=identify_inputs(args))
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
 
@@ -256,6 +258,10 @@ def validate(args: argparse.Namespace) -> None:
     if args.current and args.motor_side:
         raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     result = load_result(args.result)
+    if result.training.get("motor_side") and not args.motor_side:
+        # trained on a motor-side log: this log is read the same way (as the preparation is)
+        print("note: --motor-side (recorded in the result)", flush=True)
+        args.motor_side = True
     log = to_joint_side(args, load_log_of(args, result.robot.joint_names), result.robot)
     if args.current:
         from ..identification.drive_gains import torques_from_currents
