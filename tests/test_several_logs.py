@@ -166,3 +166,28 @@ def test_two_logs_equal_their_rows_in_one_log(two_logs, physical):
         rtol=0,
         atol=tolerance * np.abs(one.fitted).max(),
     )
+
+
+def test_min_velocity_leaves_out_rows_of_each_log(two_logs):
+    """min_velocity per joint and per log: the rows of joint j where |qd_j| < v left out of
+    each log, as a hand-built stacked OLS without those rows."""
+    robot = _arm()
+    logs = [load_log(two_logs / "a.npz"), load_log(two_logs / "b.csv")]
+    v = 0.3
+    result = identify_log(logs, robot, friction=True, method="ols", preparation={"min_velocity": v})
+    base = dynid.base_parameters(robot, friction=True)
+    A, b = [], []
+    for g in logs:
+        Y = robot.regressor(g.q, g.qd, g.qdd, friction=True)[:, :, base.independent]
+        keep = np.abs(g.qd) >= v
+        A.append(Y[keep])  # (rows kept, p)
+        b.append(g.tau[keep])
+    theta = np.linalg.lstsq(np.concatenate(A), np.concatenate(b), rcond=None)[0]
+    np.testing.assert_allclose(result.theta, theta, rtol=0, atol=1e-10 * np.abs(theta).max())
+    for entry, g in zip(result.training["logs"], logs):
+        keep = np.abs(g.qd) >= v
+        Y = robot.regressor(g.q, g.qd, g.qdd, friction=True)[:, :, base.independent]
+        error = Y @ theta - g.tau
+        rms = [np.sqrt(np.mean(error[keep[:, j], j] ** 2)) for j in range(robot.n)]
+        np.testing.assert_allclose(entry["metrics"]["rms"], rms, rtol=1e-9)
+        assert any("left out the rows of joint j" in note for note in entry["notes"])
