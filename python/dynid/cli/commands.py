@@ -7,6 +7,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from .run_config import RUN_FILE, run_yaml
+
 
 def _steps(total: int) -> Callable[[str], None]:
     start = time.perf_counter()
@@ -56,8 +58,9 @@ def log_reading(log: Any) -> str:
     return f"{log.format or 'unknown format'}" + (f"; {'; '.join(done)}" if done else "")
 
 
-def load_log_of(args: argparse.Namespace, joint_names: Any = None) -> Any:
-    """``load_log(args.log, ...)``; for a motor-side log without the warning of positions beyond
+def load_log_of(args: argparse.Namespace, joint_names: Any = None, path: Any = None) -> Any:
+    """``load_log(path or args.log, ...)``; for a motor-side log without the warning of positions
+    beyond
     100 rad, which motor angles (before the gear) may well exceed: ``to_joint_side`` checks the
     joint angles instead."""
     import warnings
@@ -67,7 +70,7 @@ def load_log_of(args: argparse.Namespace, joint_names: Any = None) -> Any:
     with warnings.catch_warnings():
         if getattr(args, "motor_side", False):
             warnings.filterwarnings("ignore", message=r".*q: positions up to", category=UserWarning)
-        return load_log(args.log, **log_options(args, joint_names))
+        return load_log(args.log if path is None else path, **log_options(args, joint_names))
 
 
 def to_joint_side(args: argparse.Namespace, log: Any, robot: Any) -> Any:
@@ -80,7 +83,7 @@ def to_joint_side(args: argparse.Namespace, log: Any, robot: Any) -> Any:
 
     joint_log = motor_to_joint(log, robot)
     print(f"note: {joint_log.notes[-1]}", flush=True)
-    check_plausible(joint_log, f"{args.log} (joint side)", unit_given=True)
+    check_plausible(joint_log, f"{log.source} (joint side)", unit_given=True)
     return joint_log
 
 
@@ -139,12 +142,16 @@ def identify(args: argparse.Namespace) -> None:
     from ..export.output_folder import check_output_path
     from ..export.result_files import save_result
     from ..identification.log_identification import identify_log
-    from ..model.model_files import load_model
 
     check_output_path(args.output, args.overwrite, inputs=identify_inputs(args))  # before the work
+    if not args.log:
+        raise ValueError("LOG: give at least one measurement log (or `log:` in --config)")
+    check_links(args, args.model, args.prior)
     if args.current and args.motor_side:
         raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     if args.current:
+        if len(args.log) != 1:
+            raise ValueError("--current: one LOG (several logs are not supported with currents)")
         identify_from_currents(args)
         return
     if any(getattr(args, k) is not None for k in ("payload_log", "payload", "payload_mass")):
@@ -156,41 +163,117 @@ def identify(args: argparse.Namespace) -> None:
     if args.friction and args.asymmetric_friction:
         raise ValueError("--friction, --asymmetric-friction: choose one friction model")
     step = _steps(5)
-    robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
-    log = load_log_of(args, robot.joint_names)
+    robot = load_robot(args, args.model)  # first: a ROS bag's joints are matched to its names
+    logs = [load_log_of(args, robot.joint_names, path) for path in args.log]
     step(
-        f"log {args.log} ({log_reading(log)}): {log.T} samples, {log.n} joints, {log.fs:.4g} Hz, "
-        f"{log.duration:.4g} s" + (f" (first {args.skip} skipped)" if args.skip else "")
+        "; ".join(
+            f"log {path} ({log_reading(log)}): {log.T} samples, {log.n} joints, "
+            f"{log.fs:.4g} Hz, {log.duration:.4g} s"
+            for path, log in zip(args.log, logs)
+        )
+        + (f" (first {args.skip} skipped)" if args.skip else "")
     )
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
-    log = to_joint_side(args, log, robot)
+    logs = [to_joint_side(args, log, robot) for log in logs]
+    # The prior is read here, a URDF's chain chosen by --tip-link, --base-link; the result
+    # records it by its path all the same.
+    prior = load_robot(args, args.prior) if args.prior is not None else None
+    method = args.method or "wls"
     result = identify_log(
-        log,
+        logs if len(logs) > 1 else logs[0],
         robot,
         rotor=args.rotor,
         friction="asymmetric" if args.asymmetric_friction else args.friction,
         offset=args.offset,
-        method=args.method or "wls",
+        method=method,
         preparation=preparation_options(args),
         physical=args.physical,
-        prior=args.prior,
+        prior=prior,
         prior_weight=args.prior_weight,
         position_torque=args.position_torque,
     )
-    new_notes = result.training["notes"][len(log.notes) :]
-    step("prepared: " + ("; ".join(new_notes) if new_notes else "used as given (no filtering)"))
+    if result.physical is not None and args.prior is not None:
+        result.physical["prior"] = str(args.prior)
+    step("prepared: " + _preparation_notes(result, logs))
     step(f"identified {result.theta.size} coefficients on {result.training['samples']} samples")
     print(result.summary(), flush=True)
     if getattr(args, "motor_side", False):  # validate maps its log the same way
         result.training["motor_side"] = True
-    path = save_result(result, args.output, overwrite=args.overwrite, inputs=identify_inputs(args))
-    step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+    path = save_result(
+        result,
+        args.output,
+        overwrite=args.overwrite,
+        inputs=identify_inputs(args),
+        # The defaults worked out here, as the run used them: the method, the prior's weight.
+        files={RUN_FILE: run_yaml(args, method=method, **_resolved_prior(result))},
+    )
+    step(
+        f"wrote {path}, {path.parent / RUN_FILE}, {path.parent / 'torques.png'}, "
+        f"{path.parent / 'residuals.png'}" + (" (and per log)" if len(logs) > 1 else "")
+    )
+
+
+def _resolved_prior(result: Any) -> dict[str, Any]:
+    """The prior weight a physical fit used (its default when --prior-weight is not given)."""
+    if result.physical is None or result.physical.get("prior") is None:
+        return {}
+    return {"prior_weight": result.physical["prior_weight"]}
+
+
+def _preparation_notes(result: Any, logs: list[Any]) -> str:
+    """What preparing the logs did (the notes beyond those of loading them), per log when
+    there are several."""
+    entries = result.training.get("logs")
+    if entries is None:
+        new = result.training["notes"][len(logs[0].notes) :]
+        return "; ".join(new) if new else "used as given (no filtering)"
+    parts = []
+    for log, entry in zip(logs, entries):
+        new = entry["notes"][len(log.notes) :]
+        parts.append(f"{log.source}: " + ("; ".join(new) if new else "used as given"))
+    return "; ".join(parts + list(result.training["notes"]))
 
 
 def identify_inputs(args: argparse.Namespace) -> list[str | None]:
     """The files ``dynid identify`` reads (options not given are None; built-in model names and
     payload numbers are no files), which ``--overwrite`` must never delete."""
-    return [args.log, args.model, args.prior, args.payload_log, args.payload]
+    return [*args.log, args.model, args.prior, args.payload_log, args.payload, args.config]
+
+
+def model_links(args: argparse.Namespace, source: Any) -> dict[str, str | None]:
+    """``--tip-link``/``--base-link`` as ``load_model``'s arguments when ``source`` is a URDF
+    (a DH table has no links to choose): empty otherwise."""
+    if source is None or not str(source).lower().endswith(".urdf"):
+        return {}
+    links = {
+        "tip_link": getattr(args, "tip_link", None),
+        "base_link": getattr(args, "base_link", None),
+    }
+    return {k: v for k, v in links.items() if v is not None}
+
+
+def check_links(args: argparse.Namespace, *sources: Any) -> None:
+    """``--tip-link``/``--base-link`` given but no URDF among the command's models: an error
+    (they would otherwise be ignored)."""
+    given = [
+        f"--{k.replace('_', '-')}" for k in ("tip_link", "base_link") if getattr(args, k, None)
+    ]
+    if given and not any(str(s).lower().endswith(".urdf") for s in sources if s is not None):
+        raise ValueError(f"{', '.join(given)}: only with a URDF model (.urdf)")
+
+
+def load_robot(args: argparse.Namespace, source: Any) -> Any:
+    """``load_model(source)`` with the command's ``--tip-link``/``--base-link`` when ``source``
+    is a URDF; a URDF with several leaves and no ``--tip-link`` says to give one."""
+    from ..model.model_files import load_model
+
+    links = model_links(args, source)
+    try:
+        return load_model(source, **links)
+    except ValueError as exc:
+        if "tip_link" in str(exc) and "tip_link" not in links:
+            raise ValueError(f"{exc} (on the command line: --tip-link LINK)") from None
+        raise
 
 
 def identify_from_currents(args: argparse.Namespace) -> None:
@@ -214,11 +297,11 @@ def identify_from_currents(args: argparse.Namespace) -> None:
         raise ValueError("--current: give exactly one of --payload FILE|NUMBERS, --payload-mass KG")
     payload = load_payload(args.payload) if args.payload is not None else None
     step = _steps(5)
-    robot = load_model(args.model)  # first: a ROS bag's joints are matched to its joint names
-    log = load_log(args.log, **log_options(args, robot.joint_names))
+    robot = load_model(args.model, **model_links(args, args.model))  # first: a ROS bag's joints
+    log = load_log(args.log[0], **log_options(args, robot.joint_names))
     loaded = load_log(args.payload_log, **log_options(args, robot.joint_names))
     step(
-        f"logs {args.log} ({log_reading(log)}; {log.T} samples), {args.payload_log} "
+        f"logs {args.log[0]} ({log_reading(log)}; {log.T} samples), {args.payload_log} "
         f"({log_reading(loaded)}; {loaded.T} samples, loaded)"
     )
     step(f"model {args.model}: {robot.name}, {robot.n} joints, {robot.convention} DH")
@@ -243,7 +326,13 @@ def identify_from_currents(args: argparse.Namespace) -> None:
         f"{sum(run['samples'] for run in gains.runs)} samples"
     )
     print(gains.summary(), flush=True)
-    path = save_result(result, args.output, overwrite=args.overwrite, inputs=identify_inputs(args))
+    path = save_result(
+        result,
+        args.output,
+        overwrite=args.overwrite,
+        inputs=identify_inputs(args),
+        files={RUN_FILE: run_yaml(args, method=args.method or "nls")},
+    )
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
 
 
@@ -253,7 +342,9 @@ def validate(args: argparse.Namespace) -> None:
     from ..identification.log_identification import run_validation
     from ..identification.validation import validation_table
 
-    check_output_path(args.output, args.overwrite, inputs=[args.result, args.log])
+    if args.result is None or args.log is None:
+        raise ValueError("RESULT, LOG: give a result and a log (or `result:`, `log:` in --config)")
+    check_output_path(args.output, args.overwrite, inputs=[args.result, args.log, args.config])
     step = _steps(3)
     if args.current and args.motor_side:
         raise ValueError("--motor-side: not with --current (motor torques, not currents)")
@@ -298,6 +389,7 @@ def validate(args: argparse.Namespace) -> None:
         result_source=str(args.result),
         log_source=str(args.log),
         overwrite=args.overwrite,
+        files={RUN_FILE: run_yaml(args)},
     )
     step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
 
@@ -336,6 +428,7 @@ def validation_preparation(result: Any, args: argparse.Namespace) -> tuple[dict[
 def export(args: argparse.Namespace) -> None:
     from ..export.result_files import export_robot
 
+    check_links(args, args.source, args.into)  # the links choose a URDF source's or --into's chain
     written = export_robot(
         args.source,
         args.urdf,
@@ -357,7 +450,8 @@ def residual(args: argparse.Namespace) -> None:
 
     inputs = [args.model, args.log]
     check_output_path(args.output, args.overwrite, inputs=inputs)
-    model = load_model_or_result(args.model)
+    check_links(args, args.model)
+    model = load_model_or_result(args.model, **model_links(args, args.model))
     log = load_log(args.log, **log_options(args, _joint_names(model)))
     result = residual_from_log(model, log, args.gain)
     with output_folder(args.output, args.overwrite, inputs=inputs) as staging:
@@ -372,9 +466,9 @@ def residual(args: argparse.Namespace) -> None:
 
 def info(args: argparse.Namespace) -> None:
     from ..export.summary import model_summary
-    from ..model.model_files import load_model
 
-    print(model_summary(load_model(args.model)))
+    check_links(args, args.model)
+    print(model_summary(load_robot(args, args.model)))
 
 
 def _joint_names(model: Any) -> Any:

@@ -10,6 +10,7 @@ from typing import Any
 
 from ..errors import PhysicalIdentificationError
 from .parsers import build_parser
+from .run_config import with_config
 
 #: Exit status for bad input (missing file, malformed log, model or result), as argparse's.
 EXIT_BAD_INPUT = 2
@@ -22,6 +23,7 @@ def main(argv: list[str] | None = None) -> int:
     args, unknown = parser.parse_known_args(argv)
     if unknown:
         args.command_parser.error(f"unrecognized arguments: {' '.join(unknown)}")
+    args = with_config(parser, args, argv)  # --config FILE: its options, the command line's first
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("always", UserWarning)

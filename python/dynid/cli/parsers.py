@@ -47,8 +47,16 @@ def _add_identify(subcommands: Any) -> None:
         description="Identify the base dynamic parameters of a DH model on a log (NPZ or CSV, "
         "docs/data.md) by least squares; write result.json and PNG plots.",
     )
-    p.add_argument("log", help="measurement log, .npz or .csv")
+    p.add_argument(
+        "log",
+        nargs="*",
+        metavar="LOG",
+        help="measurement log(s), .npz or .csv; several logs are prepared separately and "
+        "fitted together",
+    )
     _add_model(p)
+    _add_links(p)
+    _add_config(p)
     p.add_argument("--rotor", action="store_true", help="add the rotor inertia columns Ia")
     p.add_argument(
         "--friction", action="store_true", help="add viscous and Coulomb friction columns Fv, Fs"
@@ -108,8 +116,11 @@ def _add_validate(subcommands: Any) -> None:
         description="Predict the torques of LOG with a result of `dynid identify` and report "
         "per-joint RMS, relative RMS, maximum error and R^2; write validation.json and plots.",
     )
-    p.add_argument("result", help="result folder of `dynid identify`, or its result.json")
-    p.add_argument("log", help="measurement log, .npz or .csv")
+    # Optional here so that --config can give them (commands.validate checks they are there).
+    p.add_argument(
+        "result", nargs="?", help="result folder of `dynid identify`, or its result.json"
+    )
+    p.add_argument("log", nargs="?", help="measurement log, .npz or .csv")
     p.add_argument(
         "--current",
         action="store_true",
@@ -125,6 +136,7 @@ def _add_validate(subcommands: Any) -> None:
         help="apply the preparation recorded in the result (the training log's), each option "
         "given here replacing the recorded one (default: on)",
     )
+    _add_config(p)
     _add_output(p, "dynid-validate")
     p.set_defaults(run=commands.validate)
 
@@ -135,6 +147,7 @@ def _add_info(subcommands: Any) -> None:
         help="show a model: DH table, parameters, base-parameter counts",
     )
     _add_model(p)
+    _add_links(p)
     p.set_defaults(run=commands.info)
 
 
@@ -164,6 +177,7 @@ def _add_export(subcommands: Any) -> None:
     )
     p.add_argument("--name", help="robot name in the URDF (default: the model's name)")
     p.add_argument("--overwrite", action="store_true", help="replace the files if they exist")
+    _add_links(p)
     p.set_defaults(run=commands.export)
 
 
@@ -195,6 +209,7 @@ def _add_residual(subcommands: Any) -> None:
         help="draw +-T [N m] in the plot (a collision threshold)",
     )
     _add_log_reading(p)
+    _add_links(p)
     _add_output(p, "dynid-residual")
     p.set_defaults(run=commands.residual)
 
@@ -236,6 +251,31 @@ def _add_model(p: argparse.ArgumentParser) -> None:
         metavar="NAME|FILE",
         help="built-in model (kuka_lwr4, puma560, planar_2r, panda, ur5, ur10), a "
         f"model file (JSON or YAML, docs/cli.md) or a URDF; default {DEFAULT_MODEL}",
+    )
+
+
+def _add_links(p: argparse.ArgumentParser) -> None:
+    """The chain of a URDF model (commands.model_links): Robot.from_urdf's tip_link, base_link."""
+    p.add_argument(
+        "--tip-link",
+        metavar="LINK",
+        help="with a URDF model (or --prior): the last link of the chain (needed when the tree "
+        "has several leaves, e.g. ee_link and tool0)",
+    )
+    p.add_argument(
+        "--base-link",
+        metavar="LINK",
+        help="with a URDF model (or --prior): the first link of the chain (default the root)",
+    )
+
+
+def _add_config(p: argparse.ArgumentParser) -> None:
+    """Options from a run file (cli/run_config.py)."""
+    p.add_argument(
+        "--config",
+        metavar="FILE",
+        help="read the options from a YAML file, e.g. the run.yaml of a result folder (keys: "
+        "the options without --, the logs under log); options given here override it",
     )
 
 

@@ -20,7 +20,7 @@ coefficients follows from them.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Union
 
@@ -71,21 +71,31 @@ def save_result(
     plots: bool = True,
     overwrite: bool = False,
     inputs: Iterable[PathLike | None] = (),
+    files: Mapping[str, str] | None = None,
 ) -> Path:
     """Write ``folder/result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of
-    the fit on ``log`` (default: the training log, when the result kept it); returns the JSON
-    path. ``folder`` must be new or empty unless ``overwrite``, and ``overwrite`` replaces only a
-    folder dynid wrote that holds none of ``inputs`` nor the log's file; it is written as a
-    whole or not at all (:mod:`dynid.export.output_folder`)."""
+    the fit on ``log`` (default: the training log, when the result kept it; of several training
+    logs the first, the others' plots as ``torques_2.png``, ``residuals_2.png``, ...); returns
+    the JSON path. ``files`` are more text files to write into the folder (name: content, e.g.
+    ``dynid identify``'s ``run.yaml``). ``folder`` must be new or empty unless ``overwrite``,
+    and ``overwrite`` replaces only a folder dynid wrote that holds none of ``inputs`` nor the
+    logs' files; it is written as a whole or not at all (:mod:`dynid.export.output_folder`)."""
+    given = log is not None
     log = log if log is not None else result.log
-    inputs = [*inputs, log.source if log is not None else None]
+    more = result.logs[1:] if not given else ()
+    inputs = [*inputs, log.source if log is not None else None, *(m.source for m in more)]
+    _check_file_names(files, RESULT_FILE)
     with output_folder(folder, overwrite, inputs=inputs) as staging:
         (staging / RESULT_FILE).write_text(dumps_json(result_to_dict(result)) + "\n")
+        for name, text in (files or {}).items():
+            (staging / name).write_text(text)
         if plots and log is not None:
             # The training log's prediction from the fit (its regressor computed once per run).
             fitted = result.fitted if log is result.log else None
             predicted = fitted if fitted is not None else result.predict(log)
             save_plots(staging, log, predicted, "training log")
+            for k, (other, part) in enumerate(zip(more, result.fitted_logs[1:]), start=2):
+                save_plots(staging, other, part, f"training log {k}", suffix=f"_{k}")
     return Path(folder) / RESULT_FILE
 
 
@@ -97,9 +107,11 @@ def save_validation(
     log_source: str = "",
     plots: bool = True,
     overwrite: bool = False,
+    files: Mapping[str, str] | None = None,
 ) -> Path:
     """Write ``folder/validation.json`` (per-joint metrics, preparation, sources) and, when
     ``plots``, the torque and residual plots of the validation log; returns the JSON path.
+    ``files`` are more text files to write into the folder (name: content).
     ``overwrite`` never replaces a folder that holds ``result_source`` or the log's file
     (:mod:`dynid.export.output_folder`)."""
     report = {
@@ -114,15 +126,28 @@ def save_validation(
         "metrics": metrics_to_dict(validation.metrics),
     }
     inputs = [result_source, log_source, validation.log.source]
+    _check_file_names(files, VALIDATION_FILE)
     with output_folder(folder, overwrite, inputs=inputs) as staging:
         (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
+        for name, text in (files or {}).items():
+            (staging / name).write_text(text)
         if plots:
             save_plots(staging, validation.log, validation.predicted, "validation log")
     return Path(folder) / VALIDATION_FILE
 
 
-def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str) -> list[Path]:
-    """``torques.png`` (measured and predicted torque per joint) and ``residuals.png``."""
+def _check_file_names(files: Mapping[str, str] | None, main: str) -> None:
+    """The extra files of a folder: plain names (no folders), not the folder's main file."""
+    for name in files or {}:
+        if not name or Path(name).name != name or name == main:
+            raise ValueError(f"files: expected plain file names besides {main}, got {name!r}")
+
+
+def save_plots(
+    folder: Path, log: Log, predicted: NDArray[np.float64], what: str, suffix: str = ""
+) -> list[Path]:
+    """``torques.png`` (measured and predicted torque per joint) and ``residuals.png`` (their
+    names followed by ``suffix``)."""
     from .plots import plot_residuals, plot_torques  # matplotlib: imported when plotting
 
     t = log.t - log.t[0]
@@ -132,13 +157,13 @@ def save_plots(folder: Path, log: Log, predicted: NDArray[np.float64], what: str
             t,
             log.tau,
             predicted,
-            folder / "torques.png",
+            folder / f"torques{suffix}.png",
             title=f"Measured and predicted joint torques ({what}: {name})",
         ),
         plot_residuals(
             t,
             predicted - log.tau,
-            folder / "residuals.png",
+            folder / f"residuals{suffix}.png",
             title=f"Torque residuals, predicted - measured ({what}: {name})",
         ),
     ]
@@ -180,6 +205,11 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
     ]
     training = dict(result.training)
     training["metrics"] = {k: _nums(v) for k, v in training.get("metrics", {}).items()}
+    if "logs" in training:  # several training logs: each one's metrics
+        training["logs"] = [
+            dict(run, metrics={k: _nums(v) for k, v in run.get("metrics", {}).items()})
+            for run in training["logs"]
+        ]
     options = {
         "rotor": result.rotor,
         "friction": result.friction,
@@ -279,6 +309,14 @@ def result_from_dict(data: Any) -> LogIdentification:
     training["metrics"] = {
         k: _array(v, f"training.metrics.{k}", 1, nullable=True) for k, v in metrics.items()
     }
+    if "logs" in training:  # several training logs: each one's metrics as arrays too
+        runs = training["logs"]
+        if not isinstance(runs, list):
+            raise ValueError(f"training.logs: expected a list, got {type(runs).__name__}")
+        training["logs"] = [
+            _log_record(_object(run, f"training.logs[{i}]"), f"training.logs[{i}]")
+            for i, run in enumerate(runs)
+        ]
     method = _get(options, "method", "options")
     physical = data.get("physical")
     if physical is not None:
@@ -315,6 +353,15 @@ def result_from_dict(data: Any) -> LogIdentification:
         drive_gains=DriveGains.from_record(data, robot.n),
         _robot=robot,
     )
+
+
+def _log_record(run: dict[str, Any], where: str) -> dict[str, Any]:
+    """One training log's entry of ``training.logs``, its metrics as arrays."""
+    metrics = _object(run.get("metrics", {}), f"{where}.metrics")
+    run["metrics"] = {
+        k: _array(v, f"{where}.metrics.{k}", 1, nullable=True) for k, v in metrics.items()
+    }
+    return run
 
 
 def _check_friction_model(model: Any, friction: bool) -> None:
@@ -401,13 +448,18 @@ def _has_bool(value: Any) -> bool:
     return isinstance(value, list) and any(_has_bool(v) for v in value)
 
 
-def load_model_or_result(source: PathLike) -> Robot | LogIdentification:
+def load_model_or_result(
+    source: PathLike, *, tip_link: str | None = None, base_link: str | None = None
+) -> Robot | LogIdentification:
     """A result folder or ``result.json`` as a :class:`LogIdentification`, anything else as
-    :func:`~dynid.model.model_files.load_model` reads it (built-in name, model file, URDF)."""
+    :func:`~dynid.model.model_files.load_model` reads it (built-in name, model file, URDF; the
+    URDF's chain from ``base_link`` to ``tip_link``, which only a URDF may be given)."""
     path = Path(source)
     if path.is_dir() or path.name == RESULT_FILE:
+        if tip_link is not None or base_link is not None:
+            raise ValueError(f"tip_link, base_link: only for a URDF model, not for {source}")
         return load_result(path)
-    return load_model(source)
+    return load_model(source, tip_link=tip_link, base_link=base_link)
 
 
 def export_robot(
@@ -424,12 +476,13 @@ def export_robot(
     """Write the robot of ``source`` as URDF (``urdf``) and/or MuJoCo MJCF (``mjcf``; at least
     one) for ``dynid export``: ``source`` is a result folder or ``result.json`` of a physically
     consistent identification, or anything :func:`~dynid.model.model_files.load_model` reads (a
-    built-in name, a model file, a URDF). With ``into`` (the user's own URDF of the arm, its
-    chain from ``base_link`` to ``tip_link``), ``urdf`` is that file with the robot's inertials
-    and drive terms in place of its own and everything else kept (:mod:`.urdf_into`); without,
-    a fresh URDF of the DH model. A least-squares result holds base parameters only, not a
-    robot: a ValueError says so. Returns the files written. Both files are checked before
-    either is written (an existing file without ``overwrite``, a robot the format refuses)."""
+    built-in name, a model file, a URDF: its chain from ``base_link`` to ``tip_link``). With
+    ``into`` (the user's own URDF of the arm, its chain from ``base_link`` to ``tip_link``),
+    ``urdf`` is that file with the robot's inertials and drive terms in place of its own and
+    everything else kept (:mod:`.urdf_into`); without, a fresh URDF of the DH model. A
+    least-squares result holds base parameters only, not a robot: a ValueError says so. Returns
+    the files written. Both files are checked before either is written (an existing file
+    without ``overwrite``, a robot the format refuses)."""
     from ..model.urdf.writing import write_urdf
     from .mjcf import mjcf_text, write_mjcf
     from .urdf_into import urdf_into_text
@@ -438,7 +491,10 @@ def export_robot(
         raise ValueError("into: the user's URDF to update needs --urdf OUT, the file to write")
     if urdf is None and mjcf is None:
         raise ValueError("urdf, mjcf: give at least one file to write (--urdf FILE, --mjcf FILE)")
-    loaded = load_model_or_result(source)
+    # The links choose the chain of a URDF source too (a DH model or a result has none).
+    urdf_source = str(source).lower().endswith(".urdf")
+    links = {"tip_link": tip_link, "base_link": base_link} if urdf_source else {}
+    loaded = load_model_or_result(source, **links)
     if isinstance(loaded, LogIdentification):
         result = loaded
         if result.physical is None:

@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 
 from .._equality import ValueEquality
 from ..logs import signal as sig
-from ..logs.log_files import Log
+from ..logs.log_files import Log, load_log
 from ..logs.preparation import prepare_log
 from ..model.base_parameters import base_parameters
 from ..model.model_files import load_model, model_from_dict, model_to_dict
@@ -146,10 +146,14 @@ class LogIdentification(ValueEquality):
     #: ("gains", "gains_std", tau = k * current), the payload that fixed their scale and the
     #: runs; JSON-ready
     drive_gains: dict[str, Any] | None = None
-    #: the prepared training log (not saved, not compared)
+    #: the prepared training log, the first one of several (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
     #: (T, n) the torques predicted on ``log`` when identified (not saved, not compared)
     fitted: NDArray[np.float64] | None = field(default=None, repr=False, compare=False)
+    #: every prepared training log, in the order given (not saved, not compared)
+    logs: tuple[Log, ...] = field(default=(), repr=False, compare=False)
+    #: the torques predicted on each of ``logs`` when identified (not saved, not compared)
+    fitted_logs: tuple[NDArray[np.float64], ...] = field(default=(), repr=False, compare=False)
     _robot: Robot | None = field(default=None, repr=False, compare=False)  # cache of ``robot``
 
     @property
@@ -299,15 +303,21 @@ class LogIdentification(ValueEquality):
             lines.append(f"  {name:<{width}}  {value:>12.5g}  {spread}  {expr}")
         text = "\n".join(head + lines)
         metrics = self.training.get("metrics")
+        runs = self.training.get("logs") or []
         if metrics:
             arrays = {k: np.asarray(v, dtype=float) for k, v in metrics.items()}
-            text += f"\nfit on the training log ({self.training.get('samples')} samples):\n"
+            what = f"the {len(runs)} training logs" if runs else "the training log"
+            text += f"\nfit on {what} ({self.training.get('samples')} samples):\n"
+            text += validation_table(arrays)
+        for k, run in enumerate(runs, start=1):  # several logs: each one's own fit
+            arrays = {m: np.asarray(v, dtype=float) for m, v in run.get("metrics", {}).items()}
+            text += f"\nfit on log {k}, {run.get('source')} ({run.get('samples')} samples):\n"
             text += validation_table(arrays)
         return text
 
 
 def identify_log(
-    log: Log,
+    log: Log | PathLike | Sequence[Log | PathLike],
     robot: Robot,
     *,
     rotor: bool = False,
@@ -322,6 +332,13 @@ def identify_log(
     position_torque: bool = False,
 ) -> LogIdentification:
     """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
+
+    ``log`` is a :class:`dynid.Log`, the path of a log file (``dynid.load_log`` with its
+    defaults) or a list of them: several runs of the same arm, each prepared separately (no
+    filter runs across two logs), their regressor rows stacked in one least-squares problem
+    (chunk by chunk, :mod:`dynid.identification.streaming`), so the WLS weights come from the
+    residuals of all logs together. ``training["metrics"]`` is then the fit on all samples and
+    ``training["logs"]`` holds each log's source, size, notes and metrics (absent for one log).
 
     ``preparation``: options of :func:`dynid.prepare_log` (cutoff, order, differentiate,
     decimate, outlier_k, nonuniform, trim_edges) applied first; qd and qdd are computed from q
@@ -356,8 +373,7 @@ def identify_log(
     fit's UserWarning says too (its extra columns named ``extra[k]``). Raises
     :class:`dynid.PhysicalIdentificationError` when the solver fails.
     """
-    if not isinstance(log, Log):
-        raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
+    logs = _training_logs(log)
     if not isinstance(robot, Robot):
         raise ValueError(f"robot: expected a dynid.Robot, got {type(robot).__name__}")
     if not isinstance(physical, (bool, np.bool_)):
@@ -376,10 +392,16 @@ def identify_log(
     built = build_blocks(context)  # in column order (dynid.identification.blocks.registry)
     block_notes = [note for block in built for note in block.notes()]
     blocks = kept(built)
-    prepared = _with_derivatives(prepare_log(log, **_sample_options(options)), robot.n, robot.name)
-    qd, qdd = prepared.qd, prepared.qdd
-    assert qd is not None and qdd is not None  # _with_derivatives computed the missing ones
-    rows, rows_note = _moving_rows(qd, options.get("min_velocity"))
+    # Each log prepared on its own: filters and derivatives never run across two recordings;
+    # min_velocity leaves out rows per joint and per log (_moving_rows), not whole samples.
+    runs = [
+        _with_derivatives(prepare_log(one, **_sample_options(options)), robot.n, robot.name)
+        for one in logs
+    ]
+    prepared = runs[0]
+    masks = [_moving_rows(_signals(run)[1], options.get("min_velocity")) for run in runs]
+    row_masks = [mask for mask, _ in masks]
+    rows_note = masks[0][1]
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
     names, expressions = list(base.names), list(base.expressions)
     for block in blocks:
@@ -407,40 +429,57 @@ def identify_log(
         _robot=robot,
     )
     model = result.identification_model
-    # The log's regressor is computed once (C++ batch calls). Least squares: chunk by chunk
-    # into the triangular factors (dynid.identification.streaming), the chunks kept for the
-    # prediction below when they fit in REGRESSOR_CACHE_BYTES (otherwise computed again, the
-    # memory bounded by a chunk). Physical: the standard columns of the whole log, which the
-    # SDP needs anyway; the base columns are a selection of them.
-    chunks = [slice(k, k + STREAM_CHUNK) for k in range(0, prepared.T, STREAM_CHUNK)]
+    # The logs' regressor is computed once (C++ batch calls). Least squares: chunk by chunk,
+    # log after log, into the triangular factors (dynid.identification.streaming: the rows of
+    # all logs stacked, never the whole matrix), the chunks kept for the prediction below when
+    # they fit in REGRESSOR_CACHE_BYTES (otherwise computed again, the memory bounded by a
+    # chunk). Physical: the standard columns of all logs, which the SDP needs anyway; the base
+    # columns are a selection of them.
+    chunks = [
+        (r, slice(k, k + STREAM_CHUNK))
+        for r, run in enumerate(runs)
+        for k in range(0, run.T, STREAM_CHUNK)
+    ]
+    total = sum(run.T for run in runs)
+    starts = np.cumsum([0] + [run.T for run in runs])
     standard: NDArray[np.float64] | None = None
     if physical:
         standard = np.concatenate(
             [
-                model.rigid.standard_columns(prepared.q, qd, qdd),
-                model.extra_columns(prepared.q, qd),
-            ],
-            axis=2,
+                _masked(
+                    np.concatenate(
+                        [
+                            model.rigid.standard_columns(*_signals(run)),
+                            model.extra_columns(*_signals(run)[:2]),
+                        ],
+                        axis=2,
+                    ),
+                    rows,
+                )
+                for run, rows in zip(runs, row_masks)
+            ]
         )
-        if rows is not None:  # a zero row adds nothing to the least-squares objective
-            standard = np.where(rows[:, :, None], standard, 0.0)
         selected = np.concatenate(
             [base.independent, np.arange(len(base.parameter_names), standard.shape[2])]
         )
 
-    def chunk_regressor(c: slice) -> NDArray[np.float64]:
+    def chunk_regressor(r: int, c: slice) -> NDArray[np.float64]:
+        run = runs[r]
         if standard is not None:
-            return standard[c][..., selected]
-        return model.regressor(prepared.q[c], qd[c], qdd[c])
+            span = slice(starts[r] + c.start, starts[r] + min(c.stop, run.T))
+            return standard[span][..., selected]
+        q, qd, qdd = _signals(run)
+        return model.regressor(q[c], qd[c], qdd[c])
 
     cache: dict[int, NDArray[np.float64]] = {}
-    keep = standard is None and prepared.T * robot.n * len(names) * 8 <= REGRESSOR_CACHE_BYTES
+    keep = standard is None and total * robot.n * len(names) * 8 <= REGRESSOR_CACHE_BYTES
     accumulator = LeastSquaresAccumulator(robot.n, len(names), exclude_joints=exclude_joints)
-    for i, c in enumerate(chunks):
-        Y = chunk_regressor(c)
+    for i, (r, c) in enumerate(chunks):
+        Y = chunk_regressor(r, c)
         if keep:
             cache[i] = Y
-        accumulator.add(Y, prepared.tau[c], None if rows is None else rows[c])
+        rows = row_masks[r]
+        accumulator.add(Y, runs[r].tau[c], None if rows is None else rows[c])
     # The physical fit needs the least squares only for the rank, the condition number and the
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
@@ -452,27 +491,99 @@ def identify_log(
     result.covariance = fit.covariance
     result.excluded = fit.excluded
     if standard is not None:
-        tau = prepared.tau if rows is None else np.where(rows, prepared.tau, 0.0)
+        tau = np.concatenate(
+            [
+                run.tau if rows is None else np.where(rows, run.tau, 0.0)
+                for run, rows in zip(runs, row_masks)
+            ]
+        )
         _physical(
             result, standard, tau, fit.noise_variance, prior_robot, prior_weight or 0.0, prior
         )
-    result.fitted = np.concatenate(
+    fitted = np.concatenate(
         [
-            (cache[i] if i in cache else chunk_regressor(c)) @ result.theta
-            for i, c in enumerate(chunks)
+            (cache[i] if i in cache else chunk_regressor(r, c)) @ result.theta
+            for i, (r, c) in enumerate(chunks)
         ]
     )
+    result.fitted_logs = tuple(fitted[starts[r] : starts[r + 1]] for r in range(len(runs)))
+    result.fitted, result.logs = result.fitted_logs[0], tuple(runs)
+    plain = {k: _plain(v) for k, v in options.items()}
+    if len(runs) == 1:
+        result.training = {
+            "source": prepared.source,
+            "format": prepared.format,
+            "samples": prepared.T,
+            "duration_s": prepared.duration,
+            "sampling_rate_hz": prepared.fs,
+            "preparation": plain,
+            "notes": list(prepared.notes) + rows_note + block_notes,
+            "metrics": _kept_row_metrics(prepared.tau, result.fitted, row_masks[0]),
+        }
+        return result
+    # Several logs: the fit on all rows together, then each log's own (its errors against its
+    # own torques, so a log the model fits worse than the others shows).
     result.training = {
-        "source": prepared.source,
-        "format": prepared.format,
-        "samples": prepared.T,
-        "duration_s": prepared.duration,
-        "sampling_rate_hz": prepared.fs,
-        "preparation": {k: _plain(v) for k, v in options.items()},
-        "notes": list(prepared.notes) + rows_note + block_notes,
-        "metrics": _kept_row_metrics(prepared.tau, result.fitted, rows),
+        "source": [run.source for run in runs],
+        "format": [run.format for run in runs],
+        "samples": total,
+        "duration_s": sum(run.duration for run in runs),
+        "preparation": plain,
+        "notes": block_notes,
+        "metrics": _kept_row_metrics(
+            np.concatenate([run.tau for run in runs]),
+            fitted,
+            None
+            if row_masks[0] is None
+            else np.concatenate([m for m in row_masks if m is not None]),
+        ),
+        "logs": [
+            {
+                "source": run.source,
+                "format": run.format,
+                "samples": run.T,
+                "duration_s": run.duration,
+                "sampling_rate_hz": run.fs,
+                "notes": list(run.notes) + note,
+                "metrics": _kept_row_metrics(run.tau, part, rows),
+            }
+            for run, part, (rows, note) in zip(runs, result.fitted_logs, masks)
+        ],
     }
     return result
+
+
+def _masked(standard: NDArray[np.float64], rows: NDArray[np.bool_] | None) -> NDArray[np.float64]:
+    """The rows left out by min_velocity set to zero: a zero row adds nothing to the
+    least-squares objective."""
+    return standard if rows is None else np.where(rows[:, :, None], standard, 0.0)
+
+
+def _signals(log: Log) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """q, qd, qdd of a log that has them (after ``_with_derivatives``)."""
+    assert log.qd is not None and log.qdd is not None  # _with_derivatives computed them
+    return log.q, log.qd, log.qdd
+
+
+def _training_logs(log: Any) -> list[Log]:
+    """``identify_log``'s ``log``: one Log or path, or a non-empty list of them, as Logs (paths
+    read by ``dynid.load_log`` with its defaults)."""
+    items = list(log) if isinstance(log, (list, tuple)) else [log]
+    if not items:
+        raise ValueError("log: expected a dynid.Log, a log file or a list of them, got none")
+    logs = []
+    for k, item in enumerate(items):
+        where = "log" if len(items) == 1 and not isinstance(log, (list, tuple)) else f"log[{k}]"
+        if isinstance(item, Log):
+            logs.append(item)
+        elif isinstance(item, (str, Path)):
+            logs.append(load_log(item))
+        else:
+            raise ValueError(
+                f"{where}: expected a dynid.Log or the path of a log file, "
+                f"got {type(item).__name__}"
+            )
+    return logs
 
 
 def _physical(
@@ -485,8 +596,8 @@ def _physical(
     source: Any,
 ) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one; ``Y``
-    (T, n, P + e) is the standard regressor of the log followed by the blocks' columns, ``tau``
-    (T, n) its torques (the rows left out are zero in both)."""
+    (T, n, P + e) is the standard regressor of the training logs followed by the blocks'
+    columns, ``tau`` (T, n) their torques (the rows left out are zero in both)."""
     robot, n = result.robot, result.n
     model = result.identification_model
     # Each block says which of its coefficients are >= 0 (friction dissipates, as Fv, Fs >= 0).

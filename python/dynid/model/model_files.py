@@ -1,5 +1,5 @@
-"""Robot models from files: a DH table in JSON (or YAML, when PyYAML is installed), or a
-built-in name.
+"""Robot models from files: a DH table in JSON or YAML (PyYAML, a dependency of dynid imported
+when a YAML file is read), or a built-in name.
 
 A model file is one object (format in ``docs/cli.md``)::
 
@@ -76,15 +76,25 @@ MAX_YAML_ALIASES = 100
 MAX_EXPANDED_VALUES = 1_000_000
 
 
-def load_model(path_or_name: PathLike) -> Robot:
+def load_model(
+    path_or_name: PathLike, *, tip_link: str | None = None, base_link: str | None = None
+) -> Robot:
     """A built-in model (``kuka_lwr4``, ``puma560``, ``planar_2r``, ``panda``, ``ur5``,
-    ``ur10``), a model file (JSON/YAML) or a URDF file (``.urdf``: :meth:`Robot.from_urdf` with
-    its defaults: the whole chain from the root to the single leaf, standard DH).
+    ``ur10``), a model file (JSON/YAML) or a URDF file (``.urdf``: :meth:`Robot.from_urdf`, the
+    chain from ``base_link`` (default: the root) to ``tip_link`` (default: the single leaf),
+    standard DH).
 
     Raises FileNotFoundError for a missing file and ValueError naming the field that is missing
-    or malformed (prefixed by the file name).
+    or malformed (prefixed by the file name); ``tip_link`` or ``base_link`` with anything but a
+    URDF is a ValueError too (a DH table has no links to choose from).
     """
     text = str(path_or_name)
+    links = {k: v for k, v in (("tip_link", tip_link), ("base_link", base_link)) if v is not None}
+    for key, value in links.items():
+        if not isinstance(value, str) or not value:
+            raise ValueError(f"{key}: expected the name of a URDF link, got {value!r}")
+    if links and not text.lower().endswith(".urdf"):
+        raise ValueError(f"{', '.join(links)}: only for a URDF model (.urdf), not for {text!r}")
     if text in BUILTIN_MODELS:
         return BUILTIN_MODELS[text]()
     path = Path(text)
@@ -99,14 +109,14 @@ def load_model(path_or_name: PathLike) -> Robot:
         if path.suffix.lower() == ".urdf":
             if path.stat().st_size > MAX_FILE_BYTES:
                 raise ValueError(f"more than {MAX_FILE_BYTES} bytes: not a robot description")
-            return Robot.from_urdf(path)
+            return Robot.from_urdf(path, base_link=base_link, tip_link=tip_link)
         return model_from_dict(read_structured(path))
     except ValueError as exc:
         raise ValueError(f"{path}: {exc}") from None
 
 
 def save_model(robot: Robot, path: PathLike) -> Path:
-    """Write ``robot`` as a model file (JSON, or YAML for .yaml/.yml when PyYAML is installed).
+    """Write ``robot`` as a model file (JSON, or YAML for .yaml/.yml).
 
     ``load_model`` of the file gives back the same table, transforms, limits, parameters and
     drive terms (floats are written with 17 significant digits, i.e. exactly).
@@ -361,8 +371,8 @@ def _yaml(path: Path) -> Any:
         import yaml
     except ImportError:
         raise ValueError(
-            f"{path.suffix} files need PyYAML, which is not installed (it is not a dynid "
-            "dependency): `pip install pyyaml`, or write the model as JSON"
+            f"{path.suffix} files need PyYAML, which is not installed (a dependency of dynid "
+            "that this installation lacks): `pip install pyyaml`, or write the file as JSON"
         ) from None
     return yaml
 
