@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from ..model.joint_frames import joint_frames
-from ..model.urdf.consistency import body_inconsistency, joint_inconsistency, physical_form
+from ..model.urdf.consistency import check_writable, physical_form
 from ..model.urdf.writing import write_urdf as write_text
 
 #: What MuJoCo needs of a body and a joint (its compiler refuses the rest).
@@ -44,21 +44,7 @@ def mjcf_text(robot: Any, name: str | None = None) -> str:
     name = robot.name if name is None else name
     if not isinstance(name, str) or not name.strip():
         raise ValueError(f"name: expected a non-empty model name, got {name!r}")
-    if robot.coupled:
-        raise ValueError(
-            "transmission: a robot with coupled drives (transmission not the identity) cannot be "
-            "written as MJCF, whose armature, damping and frictionloss are per joint; write "
-            "robot.rigid_body() or keep it as a model file (dynid.save_model)"
-        )
-    for i in range(robot.n):
-        why = body_inconsistency(robot.params[i])
-        if why:
-            raise ValueError(
-                f"robot: link {i + 1} is not physically consistent ({why}); {BODY_RULE}"
-            )
-        why = joint_inconsistency(robot.Ia[i], robot.Fv[i], robot.Fs[i])
-        if why:
-            raise ValueError(f"robot: joint {i + 1} has {why}; in MJCF {JOINT_RULE}")
+    check_writable(robot, "MJCF", "armature, damping and frictionloss", BODY_RULE, JOINT_RULE)
     names = list(robot.joint_names)
     frames = joint_frames(robot)
     root = ET.Element("mujoco", model=name)

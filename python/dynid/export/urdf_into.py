@@ -38,7 +38,7 @@ from ..model.urdf.reading import (
     standard_parameters,
 )
 from ..model.urdf.tree import MOVABLE, ROTOR_COMMENT, _text, read_tree, serial_chain
-from ..model.urdf.writing import _number, _vector
+from ..model.urdf.writing import _number, _vector, inertia_attributes
 
 _NAMESPACE = re.compile(r'xmlns:([A-Za-z_][\w.-]*)\s*=\s*"([^"]*)"')
 
@@ -163,17 +163,7 @@ def _set_inertial(link: ET.Element, params: NDArray[np.float64], pose: NDArray[n
     values = {
         "origin": {"xyz": _vector(com_link), "rpy": "0 0 0"},
         "mass": {"value": _number(mass)},
-        "inertia": {
-            key: _number(inertia_link[r, c])
-            for key, (r, c) in (
-                ("ixx", (0, 0)),
-                ("ixy", (0, 1)),
-                ("ixz", (0, 2)),
-                ("iyy", (1, 1)),
-                ("iyz", (1, 2)),
-                ("izz", (2, 2)),
-            )
-        },
+        "inertia": inertia_attributes(inertia_link),
     }
     for tag, attributes in values.items():
         child = element.find(tag)

@@ -14,7 +14,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,3 +65,26 @@ def joint_inconsistency(Ia: float, Fv: float, Fs: float) -> str:
         if not value >= 0.0
     ]
     return f"negative {', '.join(negative)}" if negative else ""
+
+
+def check_writable(robot: Any, where: str, per_joint: str, body_rule: str, joint_rule: str) -> None:
+    """Refuse, naming the transmission, link or joint, a robot that a file format with one body
+    per link and per-joint drive fields (``per_joint``: URDF's ``<dynamics>``, MJCF's armature,
+    damping and frictionloss) cannot hold: coupled drives, a link that is no rigid body
+    (``body_rule``), negative drive terms (``joint_rule``). ``where``: "a URDF", "MJCF"."""
+    if robot.coupled:
+        raise ValueError(
+            f"transmission: a robot with coupled drives (transmission not the identity) cannot be "
+            f"written as {where.split()[-1]}, whose {per_joint} are per joint; save it with "
+            "dynid.save_model (a model file keeps the transmission), or write "
+            "robot.rigid_body()"
+        )
+    for i in range(robot.n):
+        why = body_inconsistency(robot.params[i])
+        if why:
+            raise ValueError(
+                f"robot: link {i + 1} is not physically consistent ({why}); {body_rule}"
+            )
+        why = joint_inconsistency(robot.Ia[i], robot.Fv[i], robot.Fs[i])
+        if why:
+            raise ValueError(f"robot: joint {i + 1} has {why}; in {where} {joint_rule}")

@@ -31,13 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..joint_frames import joint_frames
-from .consistency import (
-    BODY_RULE,
-    JOINT_RULE,
-    body_inconsistency,
-    joint_inconsistency,
-    physical_form,
-)
+from .consistency import BODY_RULE, JOINT_RULE, check_writable, physical_form
 
 if TYPE_CHECKING:
     from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
@@ -67,22 +61,7 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
     bad = [joint for joint in robot.joint_names if _NOT_XML.search(joint)]
     if bad:
         raise ValueError(f"joint_names: {bad[0]!r} has characters that XML 1.0 does not allow")
-    if robot.coupled:
-        raise ValueError(
-            "transmission: a robot with coupled drives (transmission not the identity) cannot be "
-            "written as URDF, whose joint <dynamics> are per joint; save it with "
-            "dynid.save_model (a model file keeps the transmission), or write "
-            "robot.rigid_body()"
-        )
-    for i in range(robot.n):
-        why = body_inconsistency(robot.params[i])
-        if why:
-            raise ValueError(
-                f"robot: link {i + 1} is not physically consistent ({why}); {BODY_RULE}"
-            )
-        why = joint_inconsistency(robot.Ia[i], robot.Fv[i], robot.Fs[i])
-        if why:
-            raise ValueError(f"robot: joint {i + 1} has {why}; in a URDF {JOINT_RULE}")
+    check_writable(robot, "a URDF", "joint <dynamics>", BODY_RULE, JOINT_RULE)
     links = [physical_form(robot.params[i]) for i in range(robot.n)]
     frames = joint_frames(robot)
     root = ET.Element("robot", name=name)
@@ -107,21 +86,7 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
             rpy=_vector(rpy(offset[:3, :3])),
         )
         ET.SubElement(inertial, "mass", value=_number(mass))
-        ET.SubElement(
-            inertial,
-            "inertia",
-            {
-                key: _number(inertia[r, c])
-                for key, (r, c) in (
-                    ("ixx", (0, 0)),
-                    ("ixy", (0, 1)),
-                    ("ixz", (0, 2)),
-                    ("iyy", (1, 1)),
-                    ("iyz", (1, 2)),
-                    ("izz", (2, 2)),
-                )
-            },
-        )
+        ET.SubElement(inertial, "inertia", inertia_attributes(inertia))
         kind = "prismatic" if robot.joint_types[i] == "P" else "revolute"
         joint = ET.SubElement(root, "joint", name=robot.joint_names[i], type=kind)
         joint.append(
@@ -194,6 +159,13 @@ def rpy(rotation: Array) -> Array:
             np.arctan2(rotation[1, 0], rotation[0, 0]),
         ]
     )
+
+
+def inertia_attributes(inertia: Array) -> dict[str, str]:
+    """URDF's <inertia> attributes (ixx, ixy, ixz, iyy, iyz, izz) of a 3 x 3 inertia."""
+    entries = {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2), "iyy": (1, 1), "iyz": (1, 2)}
+    entries["izz"] = (2, 2)
+    return {key: _number(inertia[r, c]) for key, (r, c) in entries.items()}
 
 
 def _number(value: float) -> str:
