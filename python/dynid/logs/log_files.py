@@ -20,7 +20,7 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._checks import count, is_integer, real_array
+from .._checks import count, is_integer, positive, real_array
 from .._equality import ValueEquality
 from . import signal as sig
 from .columns import check_columns, time_scale
@@ -266,7 +266,7 @@ def load_log(
             raise ValueError(f"joint_names: expected a sequence of names, got {joint_names!r}")
         joint_names = tuple(joint_names)
     if sample_time is not None:
-        sample_time = check_sample_time(sample_time, "sample_time")
+        sample_time = positive(sample_time, "sample_time")  # seconds
     options = ReadOptions(
         sample_time=sample_time,
         columns=check_columns(columns) if columns is not None else None,
@@ -295,19 +295,6 @@ def load_log(
         log = log.slice(0, log.T - skip_end, note=f"skipped the last {skip_end} samples")
     check_plausible(log, path.name, unit_given=time_unit is not None)
     return log
-
-
-def check_sample_time(value: Any, name: str) -> float:
-    """A sample time in seconds: one finite number > 0 (ValueError naming ``name``)."""
-    try:
-        if isinstance(value, (str, bytes, bool)):
-            raise TypeError
-        dt = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a number of seconds, got {value!r}") from None
-    if not np.isfinite(dt) or dt <= 0.0:
-        raise ValueError(f"{name}: expected a finite sample time > 0 s, got {value!r}")
-    return dt
 
 
 #: Sampling rates outside this band [Hz] are not a robot log read in the right time unit.

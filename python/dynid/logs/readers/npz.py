@@ -13,9 +13,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..._checks import positive
 from ..columns import matching
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log, check_sample_time
+from ..log_files import Log
 from ..messages import name_list
 from ._build import finish
 
@@ -44,7 +45,7 @@ def read(path: Path, options: ReadOptions) -> Log:
         timeless = not ({"t", "times"} & set(found)) and not (options.columns or {}).get("t")
         if timeless and "sample_time" in found and options.sample_time is None:
             # the recording's own sample time (the Staubli TX40 data's key)
-            own = check_sample_time(data["sample_time"][()], "key 'sample_time'")
+            own = positive(data["sample_time"][()], "key 'sample_time'")  # seconds
             options = replace(options, sample_time=own)
         arrays, how = keyed_arrays(
             found, data.__getitem__, options.columns, need_t=options.sample_time is None
