@@ -70,6 +70,11 @@ def test_headerless_csv_recovers_the_lwr_from_the_command_line(tmp_path: Path, c
     theta = np.array([row["value"] for row in saved["coefficients"]])
     # Every signal exact in the file (17 digits): the least squares' own rounding only.
     assert relative_error(theta, true_base(robot)) < 1e-9
+    # validate names the format of its log too (validation.json's log_format)
+    argv = ["validate", str(out), str(path), "--columns", "t=0,q=1:8,qd=8:15,qdd=15:22,tau=22:29"]
+    assert main([*argv, "--output", str(tmp_path / "v")]) == 0
+    report = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert report["log_format"] == "CSV"
 
 
 def test_drop_nonfinite_from_the_command_line(tmp_path: Path, capsys):

@@ -120,6 +120,7 @@ def save_validation(
         "dynid_version": dynid_version(),
         "result": result_source,
         "log": log_source,
+        "log_format": validation.log.format,  # the reader that recognised the log's file
         "samples": validation.log.T,
         "preparation": validation.preparation,
         "notes": validation.log.notes,
