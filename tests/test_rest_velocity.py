@@ -33,9 +33,24 @@ def test_auto_is_one_count_at_the_cutoff():
     log = quantized_log(count=1e-4)
     v = rest_velocity("auto", log.q, log.fs, 20.0)
     np.testing.assert_allclose(v, 2 * np.pi * 20.0 * 1e-4, rtol=1e-9)
-    np.testing.assert_allclose(rest_velocity("auto", log.q, log.fs, None), 1000.0 * 1e-4, rtol=1e-9)
+    # without a filter: a quarter of one count per sample (the velocity is 0 or >= fs delta / 2)
+    np.testing.assert_allclose(rest_velocity("auto", log.q, log.fs, None), 250.0 * 1e-4, rtol=1e-9)
     np.testing.assert_array_equal(rest_velocity(0.5, log.q, log.fs, None), [0.5, 0.5])
     np.testing.assert_array_equal(rest_velocity([0.1, 0.2], log.q, log.fs, None), [0.1, 0.2])
+
+
+def test_a_smooth_angle_gets_no_rest_velocity():
+    """A simulated, unquantized angle has no recurring step: its 1st percentile step is only the
+    speed 99 % of the samples exceed, so "auto" leaves it alone (0), filtered or not."""
+    t = np.arange(3000) / 1000.0
+    q = np.column_stack([0.5 * np.sin(np.pi * t), 0.3 * np.cos(2.0 * t) + 0.01 * t**2])
+    for cutoff in (None, 20.0):
+        np.testing.assert_array_equal(rest_velocity("auto", q, 1000.0, cutoff), [0.0, 0.0])
+    log = dynid.Log(t=t, q=q, tau=np.zeros_like(q))
+    np.testing.assert_array_equal(
+        dynid.prepare_log(log, cutoff=20.0, rest_velocity="auto").qd,
+        dynid.prepare_log(log, cutoff=20.0).qd,
+    )
 
 
 def test_at_rest_the_coulomb_term_vanishes():

@@ -109,6 +109,9 @@ def prepare_log(
             f"nonuniform: expected one of {', '.join(map(repr, NONUNIFORM))}, got {nonuniform!r}"
         )
     positions, fs_read = log.q, log.fs  # as read: the quantum of rest_velocity="auto"
+    # "auto" estimates the noise of a velocity differentiated from the quantized angle; a log's
+    # own velocities (a robot's estimate, e.g. libfranka's dq) are left as they are.
+    differentiated = differentiate == "always" or (log.qd is None and differentiate != "never")
     if rest_velocity is not None and log.qd is None and differentiate == "never":
         raise ValueError("rest_velocity: needs qd, but the log has none and differentiate='never'")
     if not isinstance(trim_edges, (bool, np.bool_)):
@@ -225,7 +228,8 @@ def prepare_log(
         reference = np.concatenate([s.reference for s in done if s.reference is not None])
 
     # Joints at rest: qd_j = 0 where |qd_j| is below the rest velocity (dynid.logs.rest).
-    if rest_velocity is not None and log.qd is not None:
+    auto = isinstance(rest_velocity, str) and rest_velocity == "auto"
+    if rest_velocity is not None and log.qd is not None and (differentiated or not auto):
         # the low-pass the velocities went through: the cutoff, or decimation's anti-alias one
         low_pass = (
             cutoff if cutoff is not None else (0.4 * fs_read / factor if factor > 1 else None)
