@@ -268,6 +268,11 @@ def test_identify_and_validate_a_motor_side_log(tmp_path, capsys) -> None:
     assert "note: --motor-side (recorded in the result)" in capsys.readouterr().out
     report = json.loads((tmp_path / "v2" / "validation.json").read_text())
     assert max(report["metrics"]["relative_rms"]) < 1e-9
+    # --no-motor-side reads the log as joint angles (here wrongly: a poor fit, as asked)
+    argv3 = [*argv[:3], "--no-motor-side", "--columns", columns, "--output", str(tmp_path / "v3")]
+    assert main(argv3) == 0
+    report = json.loads((tmp_path / "v3" / "validation.json").read_text())
+    assert min(report["metrics"]["relative_rms"]) > 0.01
 
 
 def test_motor_side_errors_exit_2(tmp_path, capsys) -> None:

@@ -349,7 +349,7 @@ def validate(args: argparse.Namespace) -> None:
     if args.current and args.motor_side:
         raise ValueError("--motor-side: not with --current (motor torques, not currents)")
     result = load_result(args.result)
-    if result.training.get("motor_side") and not args.motor_side:
+    if result.training.get("motor_side") and args.motor_side is None:
         # trained on a motor-side log: this log is read the same way (as the preparation is)
         print("note: --motor-side (recorded in the result)", flush=True)
         args.motor_side = True

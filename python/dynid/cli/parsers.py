@@ -345,10 +345,12 @@ def _add_motor_side(p: argparse.ArgumentParser) -> None:
     """A motor-side log (commands.to_joint_side)."""
     p.add_argument(
         "--motor-side",
-        action="store_true",
+        action=argparse.BooleanOptionalAction,
+        default=None,
         help="LOG holds motor angles and motor torques: mapped to the joints through the "
         "model's gear_ratios, transmission and joint_offsets, q = R^-1 theta - joint_offsets, "
-        "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md)",
+        "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md); validate applies it by itself "
+        "to a result trained on a motor-side log, --no-motor-side reads LOG as joint side",
     )
 
 
