@@ -220,7 +220,9 @@ def _pick(order: tuple[str, ...], names: list[str], topic: str, k: int) -> np.nd
     if missing:
         raise ValueError(
             f"joint_names: joint {missing[0]!r} of the model is not in {topic}'s message {k} "
-            f"(missing: {', '.join(missing)}); the message names {name_list(list(order))}"
+            f"(missing: {', '.join(missing)}); the message names {name_list(list(order))}: set "
+            "the model's joint_names (a model file's joint_names, Robot.joint_names, or the "
+            "robot's URDF as --model)"
         )
     return np.array([index[name] for name in names], dtype=int)
 

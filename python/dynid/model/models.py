@@ -308,6 +308,8 @@ def panda() -> Robot:
         tool=tool,
         qlim=_PANDA_QLIM,
         name="Franka Emika Panda",
+        # franka_description's joint names, as libfranka's ROS driver publishes them
+        joint_names=[f"panda_joint{j}" for j in range(1, 8)],
     )
     for i, (_, m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz) in enumerate(table):
         inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
