@@ -96,6 +96,10 @@ def prepare_log(
        per-joint masks for selecting rows of a stacked regressor instead (as
        :func:`dynid.identify_log` does).
 
+    Between them and the removals, **joints at rest** (``rest_velocity``: a velocity, one per
+    joint, or "auto"): qd_j = 0 where |qd_j| is below it, so that the Coulomb term is 0 while a
+    joint stands still instead of +-Fs at random (:mod:`dynid.logs.rest`).
+
     Sample removals come last because filters, derivatives and decimation need the uniform grid.
     """
     if not isinstance(log, Log):

@@ -21,7 +21,7 @@ grouped where they are equal up to QUANTUM_TOLERANCE (the rounding of a unit con
 q = theta / N), and the smallest group of at least QUANTIZED_SHARE of the nonzero steps is one
 encoder count. A smooth angle (a simulated log) has no recurring step, so it gets no rest
 velocity (its small steps are only the speeds near a reversal; zeroing them would bias the
-fit). On the Staubli TX40 (5 kHz, cutoff 100 Hz) the estimates are 2e-3 to 2e-2 rad/s, and its
+fit). On the Staubli TX40 (5 kHz, cutoff 100 Hz) the estimates are 1.3e-2 to 2e-2 rad/s, and its
 held-out error falls from 62.6 to 44.2 % on the wrist (docs/real_data.md).
 """
 
