@@ -59,7 +59,6 @@ from .._equality import ValueEquality
 from ..logs.log_files import Log
 from ..logs.preparation import prepare_log
 from ..model.base_parameters import base_parameters
-from ..model.model_files import model_to_dict
 from ..model.robot import Robot
 from ._qr import GroupedTriangularFactors
 from .blocks.base import Context
@@ -83,6 +82,7 @@ from .log_identification import (
     _options,
     _plain,
     _with_derivatives,
+    unfitted,
 )
 from .payload import PAYLOAD_NAMES
 from .validation import error_metrics
@@ -219,30 +219,8 @@ def identify_drive_gains(
     # (dynid.identification.blocks), as in identify_log.
     built = build_blocks(Context(robot, rotor, kind, offset, position_torque))
     column_blocks = kept(built)
-    names, expressions = list(base.names), list(base.expressions)
-    for column_block in column_blocks:
-        names += column_block.names()
-        expressions += column_block.expressions()
-    result = LogIdentification(
-        # Without the parameters and drive terms: their values were a prior, no part of the
-        # identified model.
-        model=model_to_dict(robot, identified=False),
-        rotor=rotor,
-        friction=symmetric,
-        method=method,
-        parameter_names=list(base.parameter_names),
-        independent=base.independent.copy(),
-        beta=base.beta.copy(),
-        names=names,
-        expressions=expressions,
-        theta=np.zeros(len(names)),
-        std=np.zeros(len(names)),
-        relative_std=np.zeros(len(names)),
-        condition_number=np.nan,
-        rank=0,
-        blocks=column_blocks,
-        _robot=robot,
-    )
+    result = unfitted(robot, base, column_blocks, rotor=rotor, method=method)
+    names = result.names
     system = CurrentModel(result.identification_model, DriveGains(n), known, tuple(estimated))
     unknowns = system.names(names)
     coefficients, gain, estimates = (

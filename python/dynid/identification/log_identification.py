@@ -47,7 +47,7 @@ from .._equality import ValueEquality
 from ..logs import signal as sig
 from ..logs.log_files import Log, load_log
 from ..logs.preparation import prepare_log
-from ..model.base_parameters import base_parameters
+from ..model.base_parameters import BaseParameters, base_parameters
 from ..model.model_files import load_model, model_from_dict, model_to_dict
 from ..model.robot import Robot
 from .blocks.base import Block, Context
@@ -316,6 +316,38 @@ class LogIdentification(ValueEquality):
         return text
 
 
+def unfitted(
+    robot: Robot, base: BaseParameters, blocks: Sequence[Block], *, rotor: bool, method: str
+) -> LogIdentification:
+    """The result before the fit (identify_log, identify_drive_gains): the torque model's
+    structure -- ``base`` (:func:`dynid.base_parameters` of ``robot``), then ``blocks`` -- its
+    coefficients' names and expressions, and zeros where the fit writes."""
+    names, expressions = list(base.names), list(base.expressions)
+    for block in blocks:
+        names += block.names()
+        expressions += block.expressions()
+    return LogIdentification(
+        # Without the parameters and drive terms: their values were a prior, no part of the
+        # identified model.
+        model=model_to_dict(robot, identified=False),
+        rotor=rotor,
+        friction=base.friction,
+        method=method,
+        parameter_names=list(base.parameter_names),
+        independent=base.independent.copy(),
+        beta=base.beta.copy(),
+        names=names,
+        expressions=expressions,
+        theta=np.zeros(len(names)),
+        std=np.zeros(len(names)),
+        relative_std=np.zeros(len(names)),
+        condition_number=np.nan,
+        rank=0,
+        blocks=tuple(blocks),
+        _robot=robot,
+    )
+
+
 def identify_log(
     log: Log | PathLike | Sequence[Log | PathLike],
     robot: Robot,
@@ -403,31 +435,9 @@ def identify_log(
     row_masks = [mask for mask, _ in masks]
     rows_note = masks[0][1]
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
-    names, expressions = list(base.names), list(base.expressions)
-    for block in blocks:
-        names += block.names()
-        expressions += block.expressions()
-    result = LogIdentification(
-        # Without the parameters and drive terms: their values were a prior, no part of the
-        # identified model.
-        model=model_to_dict(robot, identified=False),
-        rotor=bool(rotor),
-        friction=symmetric,
-        method=method,
-        parameter_names=list(base.parameter_names),
-        independent=base.independent.copy(),
-        beta=base.beta.copy(),
-        names=names,
-        expressions=expressions,
-        theta=np.zeros(len(names)),
-        std=np.zeros(len(names)),
-        relative_std=np.zeros(len(names)),
-        condition_number=np.nan,
-        rank=0,
-        log=prepared,
-        blocks=blocks,
-        _robot=robot,
-    )
+    result = unfitted(robot, base, blocks, rotor=bool(rotor), method=method)
+    result.log = prepared
+    names = result.names
     model = result.identification_model
     # The logs' regressor is computed once (C++ batch calls). Least squares: chunk by chunk,
     # log after log, into the triangular factors (dynid.identification.streaming: the rows of

@@ -36,6 +36,8 @@ def read(path: Path, options: ReadOptions) -> Log:
     try:
         contents = loadmat(path, squeeze_me=False, struct_as_record=True)
     except (ValueError, OSError, NotImplementedError, TypeError) as exc:
+        # loadmat's errors on a file that is no MAT file, or one of a version it does not read
+        # (NotImplementedError), reported as the log's ValueError
         raise ValueError(f"not a readable MATLAB file ({type(exc).__name__}: {exc})") from None
     variables = {k: v for k, v in contents.items() if not k.startswith("__")}
     arrays, how = keyed_arrays(
