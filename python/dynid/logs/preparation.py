@@ -7,6 +7,7 @@ and near-zero-velocity removal), each step only when asked and each recorded in 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -217,15 +218,9 @@ def prepare_log(
             f"each segment (as the longest, {longest.log.T} samples): {n}" for n in steps_notes
         ]
     whole = done[0].log if len(done) == 1 else _concatenate([s.log for s in done])
-    log = Log(
-        t=whole.t,
-        q=whole.q,
-        tau=whole.tau,
-        qd=whole.qd,
-        qdd=whole.qdd,
-        source=log.source,
-        format=log.format,
-        notes=log.notes + opening + steps_notes,
+    # the prepared arrays, with the input's source, format and notes
+    log = dataclasses.replace(
+        whole, source=log.source, format=log.format, notes=log.notes + opening + steps_notes
     )
     spikes = np.concatenate([s.spikes for s in done])
     if reference is not None:
