@@ -387,7 +387,7 @@ def test_cli_identify_current_and_validate(files, tmp_path, capsys, lwr, known):
         (["--current"], "--current: needs --payload-log"),
         (["--current", "--payload-log", "L"], "--current: give exactly one of --payload"),
         (["--payload-mass", "1"], "--payload-log, --payload, --payload-mass: only with --current"),
-        (["--method", "tls"], "--method tls: only with --current"),
+        (["--method", "nls"], "--method nls: only with --current"),
         (["--current", "--physical"], "--current: not with --physical"),
         (["--current", "--prior", "lwr"], "--current: not with --physical or --prior"),
         (

@@ -121,6 +121,26 @@ def preparation_options(args: argparse.Namespace) -> dict[str, Any]:
     return _without_defaults(options)
 
 
+def estimator_options(args: argparse.Namespace, method: str) -> dict[str, Any]:
+    """The options of the estimator ``method`` given on the command line: each option of a
+    registered estimator (``dynid.identification.estimators``) is the flag of the same name
+    (``loss`` is ``--loss``); a flag of another estimator's is refused."""
+    from ..identification.estimators.registry import LEAST_SQUARES, REGISTRY, estimator, method_name
+
+    method_name(method)
+    takes = () if method in LEAST_SQUARES else estimator(method).options
+    options = {}
+    for name in dict.fromkeys(o for r in REGISTRY.values() for o in r.options):
+        value = getattr(args, name, None)
+        if value is None:
+            continue
+        if name not in takes:
+            flag = "--" + name.replace("_", "-")
+            raise ValueError(f"{flag}: not an option of --method {method}")
+        options[name] = value
+    return options
+
+
 def _without_defaults(options: dict[str, Any]) -> dict[str, Any]:
     defaults = {"decimate": 1, "nonuniform": "resample", "trim_edges": True}
     return {k: v for k, v in options.items() if not (k in defaults and v == defaults[k])}
@@ -156,7 +176,7 @@ def identify(args: argparse.Namespace) -> None:
         return
     if any(getattr(args, k) is not None for k in ("payload_log", "payload", "payload_mass")):
         raise ValueError("--payload-log, --payload, --payload-mass: only with --current")
-    if args.method in ("nls", "tls"):
+    if args.method == "nls":
         raise ValueError(f"--method {args.method}: only with --current (motor currents)")
     if not args.physical and (args.prior is not None or args.prior_weight is not None):
         raise ValueError("--prior, --prior-weight: only with --physical")
@@ -191,6 +211,7 @@ def identify(args: argparse.Namespace) -> None:
         prior=prior,
         prior_weight=args.prior_weight,
         position_torque=args.position_torque,
+        estimator_options=estimator_options(args, method),
     )
     if result.physical is not None and args.prior is not None:
         result.physical["prior"] = str(args.prior)

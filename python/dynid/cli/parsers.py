@@ -80,9 +80,11 @@ def _add_identify(subcommands: Any) -> None:
     )
     p.add_argument(
         "--method",
-        choices=("ols", "wls", "nls", "tls"),
-        help="ordinary or weighted (per-joint noise) least squares (default wls); with "
-        "--current also nls (the default there) or tls (docs/drive_gains.md)",
+        type=_method,
+        help="ols or wls: ordinary or weighted (per-joint noise) least squares (the default); "
+        "or an estimator of docs/identification.md, 'Estimators' (robust, errors in "
+        "variables, periodic data, instrumental variables); with --current: nls (the "
+        "default there), tls, ols or wls (docs/drive_gains.md)",
     )
     p.add_argument(
         "--physical",
@@ -352,6 +354,19 @@ def _add_motor_side(p: argparse.ArgumentParser) -> None:
         "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md); validate applies it by itself "
         "to a result trained on a motor-side log, --no-motor-side reads LOG as joint side",
     )
+
+
+def _method(text: str) -> str:
+    """--method: "ols", "wls", a registered estimator (dynid.identification.estimators), or
+    with --current "nls"/"tls" (checked by the command)."""
+    from ..identification.estimators import methods
+
+    choices = tuple(dict.fromkeys((*methods(), "nls", "tls")))
+    if text not in choices:
+        raise argparse.ArgumentTypeError(
+            f"expected one of {', '.join(map(repr, choices))}, got {text!r}"
+        )
+    return text
 
 
 def _velocity_or_auto(text: str) -> float | str:

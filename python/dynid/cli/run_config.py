@@ -178,6 +178,13 @@ def _value(action: argparse.Action, value: Any, key: str) -> Any:
         if not isinstance(value, (int, float)) or isinstance(value, bool):
             raise ValueError(f"{key}: expected a number, got {value!r}")
         value = float(value)
+    elif callable(action.type):  # a parser's own type (--method, --rest-velocity): its check
+        if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+            raise ValueError(f"{key}: expected a string or a number, got {value!r}")
+        try:
+            value = action.type(str(value))
+        except (argparse.ArgumentTypeError, ValueError) as exc:
+            raise ValueError(f"{key}: {exc}") from None
     elif not isinstance(value, str):
         raise ValueError(f"{key}: expected a string, got {value!r}")
     if action.choices is not None and value not in action.choices:

@@ -245,6 +245,8 @@ def result_to_dict(result: LogIdentification) -> dict[str, Any]:
         data["physical"] = result.physical
     if result.drive_gains is not None:  # the drive-gain block's report (its own entry)
         data.update(DriveGains(result.n).record(result.drive_gains))
+    if result.estimator is not None:  # a registered estimator's report (method not ols/wls)
+        data["estimator"] = result.estimator
     return data
 
 
@@ -352,8 +354,22 @@ def result_from_dict(data: Any) -> LogIdentification:
         physical=physical,
         blocks=blocks,
         drive_gains=DriveGains.from_record(data, robot.n),
+        estimator=_estimator_record(data.get("estimator"), str(method)),
         _robot=robot,
     )
+
+
+def _estimator_record(value: Any, method: str) -> dict[str, Any] | None:
+    """result.json's ``estimator`` (the report of a registered estimator): an object whose
+    ``method`` is ``options.method``, or absent."""
+    if value is None:
+        return None
+    record = _object(value, "estimator")
+    if record.get("method") != method:
+        raise ValueError(
+            f"estimator.method: expected {method!r} (options.method), got {record.get('method')!r}"
+        )
+    return record
 
 
 def _log_record(run: dict[str, Any], where: str) -> dict[str, Any]:

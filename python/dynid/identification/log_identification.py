@@ -55,7 +55,9 @@ from .blocks.model import IdentificationModel, kept
 from .blocks.offset import OFFSET_NAME as OFFSET_NAME  # its name here before the blocks
 from .blocks.registry import build_blocks, friction_model
 from .blocks.rigid_body import RigidBody
-from .identify import VARIANCE_FLOOR
+from .estimators.base import EstimatorFit, Problem
+from .estimators.registry import LEAST_SQUARES, estimator, method_name
+from .identify import VARIANCE_FLOOR, LeastSquaresResult
 from .physical import physical_least_squares
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
@@ -146,6 +148,9 @@ class LogIdentification(ValueEquality):
     #: ("gains", "gains_std", tau = k * current), the payload that fixed their scale and the
     #: runs; JSON-ready
     drive_gains: dict[str, Any] | None = None
+    #: a registered estimator's report (``method`` not "ols"/"wls": its name, options and what
+    #: it did, e.g. iterations or outliers; :mod:`dynid.identification.estimators`); JSON-ready
+    estimator: dict[str, Any] | None = None
     #: the prepared training log, the first one of several (not saved, not compared)
     log: Log | None = field(default=None, repr=False, compare=False)
     #: (T, n) the torques predicted on ``log`` when identified (not saved, not compared)
@@ -362,6 +367,7 @@ def identify_log(
     prior: Robot | PathLike | None = None,
     prior_weight: float | None = None,
     position_torque: bool = False,
+    estimator_options: Mapping[str, Any] | None = None,
 ) -> LogIdentification:
     """Identify the base parameters of ``robot`` (its DH table, joint types, gravity) on ``log``.
 
@@ -388,7 +394,10 @@ def identify_log(
     ``training["notes"]``): a joint-side torque that depends on the joint's own position (torque
     sensor or gear ripple once per turn, cable or spring stiffness; docs/identification.md).
     ``method`` is "ols" or "wls" (weighted by each joint's noise level, the
-    default: the joints' torques differ by two orders of magnitude). ``exclude_joints`` (0-based)
+    default: the joints' torques differ by two orders of magnitude) or a registered estimator
+    (:mod:`dynid.identification.estimators`, :func:`~dynid.identification.estimators.methods`;
+    docs/identification.md, "Estimators"), which starts from the WLS fit and takes its own
+    ``estimator_options`` (its report is ``result.estimator``). ``exclude_joints`` (0-based)
     leaves those joints' rows out of the fit. Raises ValueError (RankDeficientError) when the log
     does not excite every base parameter.
 
@@ -420,6 +429,8 @@ def identify_log(
     if prior_robot is not None and prior_weight is None:
         prior_weight = DEFAULT_PRIOR_WEIGHT
     options = _options(preparation)
+    method = method_name(method)
+    estimator_options = _estimator_options(method, estimator_options)
     context = Context(robot, bool(rotor), kind, bool(offset), bool(position_torque))
     built = build_blocks(context)  # in column order (dynid.identification.blocks.registry)
     block_notes = [note for block in built for note in block.notes()]
@@ -494,8 +505,20 @@ def identify_log(
     # WLS weights: directions the data do not excite are then fixed by the constraints and the
     # prior, so rank deficiency is a warning there instead of an error.
     fit = accumulator.solve(
-        method=method, names=names, on_rank_deficient="warn" if physical else "raise"
+        method=method if method in LEAST_SQUARES else "wls",
+        names=names,
+        on_rank_deficient="warn" if physical else "raise",
     )
+    row_weights = None
+    if method not in LEAST_SQUARES:  # a registered estimator, from the WLS fit
+        Y_all = np.concatenate(
+            [cache[i] if i in cache else chunk_regressor(r, c) for i, (r, c) in enumerate(chunks)]
+        )
+        outcome = _estimate(method, estimator_options, Y_all, runs, row_masks, starts, fit, result)
+        del Y_all
+        fit, row_weights = outcome.result, outcome.row_weights
+        result.estimator = {"method": method, "options": dict(estimator_options), **outcome.report}
+        block_notes += list(outcome.notes)
     result.theta, result.std, result.relative_std = fit.theta, fit.std, fit.relative_std
     result.condition_number, result.rank = fit.condition_number, fit.rank
     result.covariance = fit.covariance
@@ -508,7 +531,14 @@ def identify_log(
             ]
         )
         _physical(
-            result, standard, tau, fit.noise_variance, prior_robot, prior_weight or 0.0, prior
+            result,
+            standard,
+            tau,
+            fit.noise_variance,
+            prior_robot,
+            prior_weight or 0.0,
+            prior,
+            row_weights,
         )
     fitted = np.concatenate(
         [
@@ -563,6 +593,64 @@ def identify_log(
     return result
 
 
+def _estimator_options(method: str, options: Mapping[str, Any] | None) -> dict[str, Any]:
+    """``estimator_options`` checked: a mapping of the options the estimator ``method`` takes
+    (none for "ols" and "wls")."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise ValueError(
+            f"estimator_options: expected a mapping of option names to values, "
+            f"got {type(options).__name__}"
+        )
+    known = () if method in LEAST_SQUARES else estimator(method).options
+    unknown = [k for k in options if k not in known]
+    if unknown:
+        takes = ", ".join(known) if known else "no options"
+        raise ValueError(
+            f"estimator_options: {', '.join(map(repr, unknown))} not an option of method "
+            f"{method!r} (it takes {takes})"
+        )
+    return dict(options)
+
+
+def _estimate(
+    method: str,
+    options: Mapping[str, Any],
+    Y: NDArray[np.float64],
+    runs: Sequence[Log],
+    row_masks: Sequence[NDArray[np.bool_] | None],
+    starts: NDArray[np.int64],
+    start: LeastSquaresResult,
+    result: LogIdentification,
+) -> EstimatorFit:
+    """The registered estimator ``method`` on the stacked problem (rows left out zeroed)."""
+    keep = np.concatenate(
+        [
+            np.ones(run.tau.shape, dtype=bool) if rows is None else rows
+            for run, rows in zip(runs, row_masks)
+        ]
+    )
+    tau = np.where(keep, np.concatenate([run.tau for run in runs]), 0.0)
+    problem = Problem(
+        Y=np.where(keep[:, :, None], Y, 0.0),
+        tau=tau,
+        keep=keep,
+        excluded=tuple(start.excluded),
+        names=list(result.names),
+        runs=tuple(runs),
+        starts=np.asarray(starts, dtype=np.int64),
+        robot=result.robot,
+        model=result.identification_model,
+        start=start,
+        options=options,
+    )
+    outcome = estimator(method).function(problem)
+    if outcome.result.theta.shape != (problem.p,):
+        raise RuntimeError(f"estimator {method!r} returned {outcome.result.theta.shape} values")
+    return outcome
+
+
 def _masked(standard: NDArray[np.float64], rows: NDArray[np.bool_] | None) -> NDArray[np.float64]:
     """The rows left out by min_velocity set to zero: a zero row adds nothing to the
     least-squares objective."""
@@ -604,6 +692,7 @@ def _physical(
     prior: Robot | None,
     prior_weight: float,
     source: Any,
+    row_weights: NDArray[np.float64] | None = None,
 ) -> None:
     """Replace the least-squares estimate in ``result`` by the physically consistent one; ``Y``
     (T, n, P + e) is the standard regressor of the training logs followed by the blocks'
@@ -615,17 +704,20 @@ def _physical(
     weights = np.ones(n)
     kept = [j for j in range(n) if j not in result.excluded]
     usable = np.all(np.isfinite(noise_variance)) and noise_variance.max() > 0
-    if result.method == "wls" and usable:  # as dynid.least_squares: 1 / sigma_j
+    if result.method != "ols" and usable:  # as dynid.least_squares: 1 / sigma_j
         floored = np.maximum(noise_variance, VARIANCE_FLOOR * noise_variance.max())
         weights[kept] = 1.0 / np.sqrt(floored)
     weights[list(result.excluded)] = 0.0
+    # An estimator's own row weights (e.g. IRLS's robust weights) times the joints' 1/sigma_j:
+    # the physically consistent fit of the same method.
+    row_weighted = weights if row_weights is None else row_weights * weights
     fit = physical_least_squares(
         robot,
         Y,
         tau,
         rotor=result.rotor,
         friction=result.friction,
-        weights=weights,
+        weights=row_weighted,
         prior=prior,
         prior_weight=prior_weight,
         extra_columns=model.extra_size,
