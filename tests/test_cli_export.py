@@ -1,6 +1,7 @@
 """`dynid identify --physical --prior` and `dynid export`: the exported URDF is the identified
-robot (checked through Robot.from_urdf and Pinocchio's parser, 1e-12), least-squares results are
-refused, options are checked."""
+robot (checked through Robot.from_urdf and Pinocchio's parser, 1e-12), a least-squares result
+whose base parameters no rigid bodies have is refused (tests/test_realize.py: the consistent
+ones), options are checked."""
 
 from __future__ import annotations
 
@@ -67,7 +68,7 @@ def test_export_refuses_least_squares_results_and_existing_files(
     assert dynid.cli.main(["identify", LOG, "--skip", "4500", "--output", str(plain)]) == 0
     capsys.readouterr()
     assert dynid.cli.main(["export", str(plain), "--urdf", str(tmp_path / "x.urdf")]) == 2
-    assert "base parameters only" in capsys.readouterr().err
+    assert "not physically consistent" in capsys.readouterr().err
     target = tmp_path / "model.urdf"
     assert dynid.cli.main(["export", "ur5", "--urdf", str(target)]) == 0
     assert dynid.cli.main(["export", "ur5", "--urdf", str(target)]) == 2

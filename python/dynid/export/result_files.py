@@ -497,9 +497,12 @@ def export_robot(
     ``into`` (the user's own URDF of the arm, its chain from ``base_link`` to ``tip_link``),
     ``urdf`` is that file with the robot's inertials and drive terms in place of its own and
     everything else kept (:mod:`.urdf_into`); without, a fresh URDF of the DH model. A
-    least-squares result holds base parameters only, not a robot: a ValueError says so. Returns
+    least-squares result is exported as the physically consistent robot with its base
+    parameters (:func:`dynid.identification.realize.consistent_robot`); a ValueError says when
+    there is none (then identify with --physical). Returns
     the files written. Both files are checked before either is written (an existing file
     without ``overwrite``, a robot the format refuses)."""
+    from ..identification.realize import consistent_robot
     from ..model.urdf.writing import write_urdf
     from .mjcf import mjcf_text, write_mjcf
     from .urdf_into import urdf_into_text
@@ -513,13 +516,10 @@ def export_robot(
     links = {"tip_link": tip_link, "base_link": base_link} if urdf_source else {}
     loaded = load_model_or_result(source, **links)
     if isinstance(loaded, LogIdentification):
-        result = loaded
-        if result.physical is None:
-            raise ValueError(
-                f"{source}: a least-squares result holds base parameters only, not a full robot; "
-                "identify with --physical (dynid identify LOG --physical) to export a model"
-            )
-        robot = result.robot
+        try:  # a least-squares result: the consistent robot with its base parameters
+            robot = consistent_robot(loaded)
+        except ValueError as exc:
+            raise ValueError(f"{source}: {exc}") from None
     else:
         robot = loaded
     name = name or robot.name
