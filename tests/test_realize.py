@@ -61,7 +61,7 @@ def test_export_writes_it(exact, tmp_path):
 
 
 def test_an_estimate_no_rigid_body_has_is_refused(exact, tmp_path, capsys):
-    robot, result = exact
+    _, result = exact
     # Ia_7 enters the base parameters alone (the last joint's rotor): a negative value is a
     # rotor no motor has, whatever the links.
     k = result.names.index("Ia7")
