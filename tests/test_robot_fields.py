@@ -64,10 +64,13 @@ OTHER_STRUCTURE: dict[str, Any] = {
 VALUES: dict[str, Any] = {
     "name": "every field",
     "joint_names": ("shoulder", "slider", "wrist"),
+    "link_names": ("upper", "carriage", "hand"),
     "gravity": np.array([0.5, -1.0, -9.7]),
     "base": _pose(0.3, [0.1, 0.2, 0.3]),
     "tool": _pose(-0.7, [0.02, 0.05, 0.12]),
     "qlim": np.array([[-1.0, 2.0], [-0.25, 0.5], [-2.5, 0.5]]),
+    "velocity_limits": np.array([2.0, 0.5, 3.0]),
+    "effort_limits": np.array([80.0, 300.0, 12.0]),
     "params": _links(),
     "Ia": np.array([0.1, 0.2, 0.3]),
     "Fv": np.array([1.5, 2.5, 3.5]),
@@ -80,10 +83,13 @@ VALUES: dict[str, Any] = {
 DEFAULTS: dict[str, Any] = {
     "name": "3-dof arm",
     "joint_names": ("q1", "q2", "q3"),
+    "link_names": ("link1", "link2", "link3"),
     "gravity": np.array([0.0, 0.0, -9.81]),
     "base": np.eye(4),
     "tool": np.eye(4),
     "qlim": np.array([[-np.pi, np.pi], [-1.0, 1.0], [-np.pi, np.pi]]),
+    "velocity_limits": np.full(3, np.inf),
+    "effort_limits": np.full(3, np.inf),
     "params": np.zeros((3, 10)),
     "Ia": np.zeros(3),
     "Fv": np.zeros(3),
@@ -165,6 +171,9 @@ def test_model_files_leave_out_only_the_defaults_flagged_so() -> None:
     omitted = {f.file_key for f in robot_fields.FIELDS if f.omit_default}
     assert omitted == {
         "joint_names",
+        "link_names",
+        "velocity_limits",
+        "effort_limits",
         "base",
         "tool",
         "transmission",
@@ -173,6 +182,24 @@ def test_model_files_leave_out_only_the_defaults_flagged_so() -> None:
     }
     assert set(written) == {"format"} | {f.file_key for f in robot_fields.FIELDS} - omitted
     assert set(model_to_dict(_robot())) == {"format"} | {f.file_key for f in robot_fields.FIELDS}
+
+
+def test_unknown_limits_are_null_in_files_and_never_zero(tmp_path) -> None:
+    """A limit the model does not know is inf, null in model files (JSON has no infinity), and
+    a value <= 0 or NaN is refused naming the field."""
+    robot = _robot()
+    robot.velocity_limits = [2.0, np.inf, 3.0]
+    data = json.loads(json.dumps(model_to_dict(robot)))
+    assert data["velocity_limits"] == [2.0, None, 3.0]
+    np.testing.assert_array_equal(model_from_dict(data).velocity_limits, [2.0, np.inf, 3.0])
+    for bad in ([2.0, 0.0, 3.0], [2.0, -1.0, 3.0], [2.0, np.nan, 3.0]):
+        with pytest.raises(ValueError, match="velocity_limits: joint 2"):
+            robot.velocity_limits = bad
+    with pytest.raises(ValueError, match=r"effort_limits: expected shape \(3,\)"):
+        robot.effort_limits = [1.0, 2.0]
+    data["effort_limits"] = [1.0, "x", 2.0]
+    with pytest.raises(ValueError, match=r"effort_limits\[1\]: expected a finite number"):
+        model_from_dict(data)
 
 
 @pytest.fixture(scope="module")

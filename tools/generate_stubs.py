@@ -137,7 +137,10 @@ SETTER_TYPES: dict[str, str] = {
     "joint_offsets": ARRAY_LIKE,
     "name": "str",
     "joint_names": "typing.Sequence[str]",
+    "link_names": "typing.Sequence[str]",
     "qlim": ARRAY_LIKE,
+    "velocity_limits": ARRAY_LIKE,
+    "effort_limits": ARRAY_LIKE,
     "forgetting": "float",
     "max_variance": "float | None",
 }
@@ -154,6 +157,7 @@ RETURN_REPLACEMENTS: dict[str, tuple[str, str]] = {
     "_simulate": ("typing.Any]", f"{ARRAY} | None]"),
     # a py::tuple of n strings
     "joint_names": ("tuple", "tuple[str, ...]"),
+    "link_names": ("tuple", "tuple[str, ...]"),
 }
 
 DEF = re.compile(

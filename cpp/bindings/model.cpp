@@ -66,6 +66,36 @@ VectorX parse_drive(py::handle obj, const char* name, int n) {
   return ConstVec(a.data(), n);
 }
 
+// A sequence of strings (a str alone is refused: "abc" would name three joints a, b, c).
+std::vector<std::string> parse_names(py::handle value, const char* name) {
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
+    throw py::value_error(std::string(name) + ": expected a sequence of strings, got " +
+                          std::string(py::repr(value)));
+  std::vector<std::string> names;
+  for (py::handle item : value) {
+    if (!py::isinstance<py::str>(item))
+      throw py::value_error(std::string(name) + ": expected strings, got " +
+                            std::string(py::repr(item)));
+    names.push_back(item.cast<std::string>());
+  }
+  return names;
+}
+
+py::tuple names_tuple(const std::vector<std::string>& names) {
+  py::tuple out(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) out[i] = names[i];
+  return out;
+}
+
+// n limits: infinity allowed (not limited); the model's setter refuses NaN and values <= 0.
+VectorX parse_limits(py::handle obj, const char* name, int n) {
+  Array a = as_real_array(obj, name);
+  if (a.ndim() != 1 || a.shape(0) != n)
+    throw py::value_error(std::string(name) + ": expected shape (" + std::to_string(n) +
+                          ",), got " + shape_string(a));
+  return ConstVec(a.data(), n);
+}
+
 }  // namespace
 
 namespace {
@@ -135,30 +165,24 @@ void bind_model(py::module_& m) {
           },
           "A label for printing; '<n>-dof arm' by default.")
       .def_property(
-          "joint_names",
-          [](const PyModel& self) {
-            py::tuple names(self.model->n());
-            for (int i = 0; i < self.model->n(); ++i) names[i] = self.model->joint_names()[i];
-            return names;
-          },
+          "joint_names", [](const PyModel& self) { return names_tuple(self.model->joint_names()); },
           [](PyModel& self, py::handle value) {
-            // A str is a sequence too: "abc" would name three joints a, b, c.
-            if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
-              throw py::value_error("joint_names: expected a sequence of strings, got " +
-                                    std::string(py::repr(value)));
-            std::vector<std::string> names;
-            for (py::handle item : value) {
-              if (!py::isinstance<py::str>(item))
-                throw py::value_error("joint_names: expected strings, got " +
-                                      std::string(py::repr(item)));
-              names.push_back(item.cast<std::string>());
-            }
+            std::vector<std::string> names = parse_names(value, "joint_names");
             // std::invalid_argument (count, empty, repeated) reaches Python as a ValueError.
             self.modify([&](Model& model) { model.set_joint_names(std::move(names)); });
           },
           "One name per joint (tuple of n strings), 'q1'..'qn' by default; Robot.from_urdf takes "
           "the URDF's joint names. Logs that name their joints (ROS JointState) are matched to "
           "them. ValueError naming joint_names unless n non-empty, distinct strings.")
+      .def_property(
+          "link_names", [](const PyModel& self) { return names_tuple(self.model->link_names()); },
+          [](PyModel& self, py::handle value) {
+            std::vector<std::string> names = parse_names(value, "link_names");
+            self.modify([&](Model& model) { model.set_link_names(std::move(names)); });
+          },
+          "One name per link (tuple of n strings; the body moved by joint i), 'link1'..'linkn' by "
+          "default; Robot.from_urdf takes the URDF's link names, the URDF and MJCF writers use "
+          "them. ValueError naming link_names unless n non-empty, distinct strings.")
       .def_property(
           "qlim",
           [](const PyModel& self) {
@@ -175,6 +199,24 @@ void bind_model(py::module_& m) {
           },
           "Joint limits (n, 2), rows [lower, upper]; default (-pi, pi) for revolute and (-1, 1) m "
           "for prismatic joints. ValueError naming qlim unless finite with lower < upper.")
+      .def_property(
+          "velocity_limits",
+          [](const PyModel& self) { return vector_property(self.model->velocity_limits()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX limits = parse_limits(v, "velocity_limits", self.model->n());
+            self.modify([&](Model& model) { model.set_velocity_limits(limits); });
+          },
+          "Joint velocity limits (n,), rad/s or m/s; inf (not known, not limited) by default. "
+          "ValueError naming velocity_limits unless every value > 0 (inf allowed).")
+      .def_property(
+          "effort_limits",
+          [](const PyModel& self) { return vector_property(self.model->effort_limits()); },
+          [](PyModel& self, py::handle v) {
+            const VectorX limits = parse_limits(v, "effort_limits", self.model->n());
+            self.modify([&](Model& model) { model.set_effort_limits(limits); });
+          },
+          "Joint effort limits (n,), N m or N; inf (not known, not limited) by default. "
+          "ValueError naming effort_limits unless every value > 0 (inf allowed).")
       .def_property(
           "gravity_vector",
           [](const PyModel& self) { return vector_property(self.model->gravity()); },

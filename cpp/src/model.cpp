@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -51,11 +52,14 @@ Model::Model(std::vector<DHRow> rows, Convention convention, const Vector3& grav
   set_tool(tool);
   name_ = std::to_string(n_) + "-dof arm";
   for (int i = 0; i < n_; ++i) joint_names_.push_back("q" + std::to_string(i + 1));
+  for (int i = 0; i < n_; ++i) link_names_.push_back("link" + std::to_string(i + 1));
   qlim_.resize(n_, 2);
   for (int i = 0; i < n_; ++i) {
     const double limit = rows_[i].type == JointType::Revolute ? kPi : 1.0;
     qlim_.row(i) << -limit, limit;
   }
+  velocity_limits_ = VectorX::Constant(n_, std::numeric_limits<double>::infinity());
+  effort_limits_ = VectorX::Constant(n_, std::numeric_limits<double>::infinity());
   parameters_ = MatrixX::Zero(n_, 10);
   Ia_ = VectorX::Zero(n_);
   Fv_ = VectorX::Zero(n_);
@@ -115,19 +119,32 @@ void Model::set_tool(const Matrix4& tool) {
 
 void Model::set_name(std::string name) { name_ = std::move(name); }
 
-void Model::set_joint_names(std::vector<std::string> joint_names) {
-  if (static_cast<int>(joint_names.size()) != n_)
-    throw std::invalid_argument("joint_names: expected " + std::to_string(n_) + " names, got " +
-                                std::to_string(joint_names.size()));
-  for (std::size_t i = 0; i < joint_names.size(); ++i) {
-    if (joint_names[i].empty())
-      throw std::invalid_argument("joint_names: name " + std::to_string(i) + " is empty");
+namespace {
+// n names, none empty, no two alike (what `field` names: joints or links).
+void require_names(const std::vector<std::string>& names, int n, const std::string& field,
+                   const char* what) {
+  if (static_cast<int>(names.size()) != n)
+    throw std::invalid_argument(field + ": expected " + std::to_string(n) + " names, got " +
+                                std::to_string(names.size()));
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i].empty())
+      throw std::invalid_argument(field + ": name " + std::to_string(i) + " is empty");
     for (std::size_t k = 0; k < i; ++k)
-      if (joint_names[k] == joint_names[i])
-        throw std::invalid_argument("joint_names: '" + joint_names[i] + "' names joints " +
+      if (names[k] == names[i])
+        throw std::invalid_argument(field + ": '" + names[i] + "' names " + what + " " +
                                     std::to_string(k) + " and " + std::to_string(i));
   }
+}
+}  // namespace
+
+void Model::set_joint_names(std::vector<std::string> joint_names) {
+  require_names(joint_names, n_, "joint_names", "joints");
   joint_names_ = std::move(joint_names);
+}
+
+void Model::set_link_names(std::vector<std::string> link_names) {
+  require_names(link_names, n_, "link_names", "links");
+  link_names_ = std::move(link_names);
 }
 
 void Model::set_joint_limits(const Eigen::Ref<const MatrixX>& qlim) {
@@ -212,6 +229,30 @@ void Model::set_transmission(const Eigen::Ref<const MatrixX>& T) {
   T_ = T;
   transmission_identity_ = T_ == MatrixX::Identity(n_, n_);
   update_drive_matrices();
+}
+
+namespace {
+// n positive limits, +infinity allowed (not limited); NaN, zero and negative values refused.
+void require_limits(const VectorIn& limits, int n, const char* name) {
+  if (limits.size() != n)
+    throw std::invalid_argument(std::string(name) + ": expected " + std::to_string(n) +
+                                " values, got " + std::to_string(limits.size()));
+  for (int i = 0; i < n; ++i)
+    if (!(limits[i] > 0.0))  // also NaN
+      throw std::invalid_argument(std::string(name) + ": joint " + std::to_string(i + 1) + " has " +
+                                  std::to_string(limits[i]) +
+                                  " (expected a value > 0, or infinity for no limit)");
+}
+}  // namespace
+
+void Model::set_velocity_limits(const VectorIn& limits) {
+  require_limits(limits, n_, "velocity_limits");
+  velocity_limits_ = limits;
+}
+
+void Model::set_effort_limits(const VectorIn& limits) {
+  require_limits(limits, n_, "effort_limits");
+  effort_limits_ = limits;
 }
 
 void Model::set_gear_ratios(const VectorIn& gear_ratios) {

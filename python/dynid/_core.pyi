@@ -333,6 +333,13 @@ class Model:
         DH table (n, 4), rows [a, alpha, d, theta] as given.
         """
     @property
+    def effort_limits(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Joint effort limits (n,), N m or N; inf (not known, not limited) by default. ValueError naming effort_limits unless every value > 0 (inf allowed).
+        """
+    @effort_limits.setter
+    def effort_limits(self, arg1: numpy.typing.ArrayLike) -> None: ...
+    @property
     def gear_ratios(self) -> numpy.typing.NDArray[numpy.float64]:
         """
         Gear ratios (n,), motor angle over joint angle: motor-side logs map to the joints through R = diag(gear_ratios) T (docs/data.md). Ones by default; ValueError naming gear_ratios for a zero or non-finite value.
@@ -362,6 +369,13 @@ class Model:
     def joint_offsets(self, arg1: numpy.typing.ArrayLike) -> None: ...
     @property
     def joint_types(self) -> str: ...
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """
+        One name per link (tuple of n strings; the body moved by joint i), 'link1'..'linkn' by default; Robot.from_urdf takes the URDF's link names, the URDF and MJCF writers use them. ValueError naming link_names unless n non-empty, distinct strings.
+        """
+    @link_names.setter
+    def link_names(self, arg1: typing.Sequence[str]) -> None: ...
     @property
     def n(self) -> int:
         """
@@ -402,6 +416,13 @@ class Model:
         """
     @transmission.setter
     def transmission(self, arg1: numpy.typing.ArrayLike | None) -> None: ...
+    @property
+    def velocity_limits(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Joint velocity limits (n,), rad/s or m/s; inf (not known, not limited) by default. ValueError naming velocity_limits unless every value > 0 (inf allowed).
+        """
+    @velocity_limits.setter
+    def velocity_limits(self, arg1: numpy.typing.ArrayLike) -> None: ...
 
 class MomentumObserver:
     """

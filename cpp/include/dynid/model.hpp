@@ -67,12 +67,29 @@ class Model {
   const std::vector<std::string>& joint_names() const { return joint_names_; }
   void set_joint_names(std::vector<std::string> joint_names);
 
+  // One name per link (the body moved by joint i), "link1".."linkn" by default (a URDF's link
+  // names through Robot.from_urdf): what the URDF and MJCF writers call the bodies. Same rules
+  // as joint_names (std::invalid_argument naming `link_names`).
+  const std::vector<std::string>& link_names() const { return link_names_; }
+  void set_link_names(std::vector<std::string> link_names);
+
   // Joint limits, n x 2 rows [lower, upper] (rad or m): (-pi, pi) for a revolute and (-1, 1) m
   // for a prismatic joint by default. Data for the user of the model (random configurations,
   // excitation, bounds); no algorithm reads them. set_joint_limits throws std::invalid_argument
   // naming `qlim` unless the matrix is n x 2, finite and every lower limit is below its upper.
   const MatrixX& joint_limits() const { return qlim_; }
   void set_joint_limits(const Eigen::Ref<const MatrixX>& qlim);
+
+  // Velocity and effort limits, n each (rad/s or m/s; N m or N): a URDF's <limit velocity
+  // effort>, written back into URDF and MJCF files. +infinity (not known, not limited) by
+  // default, so a model without them never claims a limit of 0. Data for the user of the model
+  // (excitation bounds, exported files); no algorithm reads them. The setters throw
+  // std::invalid_argument naming `velocity_limits` / `effort_limits` unless n values > 0
+  // (+infinity allowed, NaN not).
+  const VectorX& velocity_limits() const { return velocity_limits_; }
+  const VectorX& effort_limits() const { return effort_limits_; }
+  void set_velocity_limits(const VectorIn& limits);
+  void set_effort_limits(const VectorIn& limits);
 
   // Standard parameters, n x 10, row i about the origin of DH frame i (standard order
   // (docs/conventions.md)).
@@ -145,8 +162,9 @@ class Model {
   Vector3 gravity_;
   Matrix4 base_, tool_;
   std::string name_;
-  std::vector<std::string> joint_names_;
+  std::vector<std::string> joint_names_, link_names_;
   MatrixX qlim_;
+  VectorX velocity_limits_, effort_limits_;
   MatrixX parameters_;
   VectorX Ia_, Fv_, Fs_;
   MatrixX T_, drive_inertia_, drive_damping_;

@@ -52,7 +52,8 @@ def mjcf_text(robot: Any, name: str | None = None) -> str:
         ET.Comment(
             f" Written by dynid from a {robot.n}-joint {robot.convention}-DH model. Body i's frame "
             "is joint i's frame (z on its axis); armature = rotor inertia Ia, damping = Fv, "
-            "frictionloss = Fs. "
+            "frictionloss = Fs; a motor's ctrlrange is the joint's effort limit (MJCF has no "
+            "velocity limit). "
         )
     )
     ET.SubElement(root, "compiler", angle="radian", autolimits="true")
@@ -63,7 +64,7 @@ def mjcf_text(robot: Any, name: str | None = None) -> str:
         body = ET.SubElement(
             parent,
             "body",
-            name=f"link{i + 1}",
+            name=robot.link_names[i],
             pos=_vector(placement[:3, 3]),
             quat=_vector(_quaternion(placement[:3, :3])),
         )
@@ -98,8 +99,11 @@ def mjcf_text(robot: Any, name: str | None = None) -> str:
         quat=_vector(_quaternion(frames.tool[:3, :3])),
     )
     actuators = ET.SubElement(root, "actuator")
-    for joint in names:
-        ET.SubElement(actuators, "motor", name=f"{joint}_motor", joint=joint, gear="1")
+    for joint, effort in zip(names, robot.effort_limits):
+        motor = {"name": f"{joint}_motor", "joint": joint, "gear": "1"}
+        if np.isfinite(effort):  # gear 1: the control is the joint torque (autolimits)
+            motor["ctrlrange"] = _vector([-effort, effort])
+        ET.SubElement(actuators, "motor", motor)
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 

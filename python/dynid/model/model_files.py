@@ -12,7 +12,8 @@ A model file is one object (format in ``docs/cli.md``)::
 ``[a, alpha, d, theta]``; in modified DH the names ``a_prev`` and ``alpha_prev`` (a_{i-1},
 alpha_{i-1}) may replace ``a`` and ``alpha``, as in the LWR4+ tables of
 ``tests/data/kuka_lwr4_dh.json``. Optional: ``name``, ``joint_types`` (default all revolute),
-``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4), ``qlim`` (n x 2), ``params`` (n x
+``gravity`` (default (0, 0, -9.81)), ``base`` and ``tool`` (4x4), ``qlim`` (n x 2),
+``velocity_limits`` and ``effort_limits`` (n numbers > 0 each, null for no limit), ``params`` (n x
 10 standard parameters), ``Ia``, ``Fv``, ``Fs`` (n each), ``transmission`` (n x n coupling matrix T,
 theta_dot = T qd; docs/transmission.md; absent means identity). Unknown fields are errors, so that a
 misspelt ``gravity`` is not silently replaced by the default.
@@ -203,6 +204,8 @@ def model_to_dict(robot: Robot, identified: bool = True) -> dict[str, Any]:
             data[f.file_key] = str(value)
         elif f.kind == "names":
             data[f.file_key] = [str(v) for v in value]
+        elif f.kind == "limits":  # no limit (inf) is null: JSON has no infinity
+            data[f.file_key] = [None if np.isinf(v) else float(v) for v in value]
         else:
             data[f.file_key] = _floats(value)
     return data
@@ -221,6 +224,17 @@ def _value(value: Any, field: robot_fields.RobotField, n: int) -> Any:
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             raise ValueError(f"{field.file_key}: expected a list of {n} strings, got {value!r:.60}")
         return value
+    if field.kind == "limits":  # null: no limit (inf); the setter refuses values <= 0
+        if not isinstance(value, list) or len(value) != n:
+            raise ValueError(
+                f"{field.file_key}: expected a list of {n} numbers or nulls, got {value!r:.60}"
+            )
+        return np.array(
+            [
+                np.inf if v is None else _number(v, f"{field.file_key}[{i}]")
+                for i, v in enumerate(value)
+            ]
+        )
     return _numbers(value, field.file_key, field.shape_for(n))
 
 

@@ -271,6 +271,10 @@ _PANDA_QLIM = np.array([
     [-2.8973, 2.8973], [-1.7628, 1.7628], [-2.8973, 2.8973], [-3.0718, -0.0698],
     [-2.8973, 2.8973], [-0.0175, 3.7525], [-2.8973, 2.8973],
 ])  # fmt: skip
+# Franka's "Robot and interface specifications" (frankaemika.github.io/docs/control_parameters):
+# the maximum joint torques [N m] and velocities [rad/s] of the arm (libfranka's limits).
+_PANDA_EFFORT = np.array([87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0])
+_PANDA_VELOCITY = np.array([2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61])
 
 
 def panda() -> Robot:
@@ -311,6 +315,8 @@ def panda() -> Robot:
         # franka_description's joint names, as libfranka's ROS driver publishes them
         joint_names=[f"panda_joint{j}" for j in range(1, 8)],
     )
+    robot.link_names = [f"panda_link{j}" for j in range(1, 8)]
+    robot.effort_limits, robot.velocity_limits = _PANDA_EFFORT, _PANDA_VELOCITY
     for i, (_, m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz) in enumerate(table):
         inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
         robot.set_link(i, m, (cx, cy, cz), inertia)

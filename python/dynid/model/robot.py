@@ -153,6 +153,8 @@ class Robot(_core.Model):
             joint_names=model.joint_names,
         )
         robot.Ia, robot.Fv, robot.Fs = model.Ia, model.Fv, model.Fs
+        robot.link_names = model.link_names
+        robot.velocity_limits, robot.effort_limits = model.velocity_limits, model.effort_limits
         return robot
 
     def to_urdf(

@@ -66,7 +66,8 @@ class RobotField:
     #: ``attribute`` says otherwise.
     key: str
     #: "text" (a string), "names" (a tuple of ``shape`` strings; a list in files), "array"
-    #: (float64 of ``shape``) or "dh" (the DH table, (n, 4): model files hold it as rows of named
+    #: (float64 of ``shape``), "limits" (float64 of ``shape``, each > 0 or inf for no limit;
+    #: null in files) or "dh" (the DH table, (n, 4): model files hold it as rows of named
     #: values, :mod:`dynid.model.model_files`).
     kind: str
     #: Shape of an array; "n" stands for the number of joints.
@@ -140,8 +141,16 @@ FIELDS: tuple[RobotField, ...] = (
     # Logs that name their joints (a ROS JointState) are matched to these (docs/data.md).
     RobotField("joint_names",  "names", ("n",),     "label",     "omit_default",  "names",
                label="joint names"),
+    # The URDF and MJCF writers name the bodies by these (a URDF's own through from_urdf).
+    RobotField("link_names",   "names", ("n",),     "label",     "omit_default",  "names",
+               label="link names"),
     RobotField("qlim",         "array", ("n", 2),   "limits",    "",              "joint columns",
                label="qmin qmax"),
+    # inf: not known, not limited (the default); files write it as null (dynid.model.model_files).
+    RobotField("velocity_limits", "limits", ("n",), "limits",    "omit_default",  "per joint",
+               label="velocity limits"),
+    RobotField("effort_limits", "limits", ("n",),   "limits",    "omit_default",  "per joint",
+               label="effort limits"),
     RobotField("params",       "array", ("n", 10),  "links",     "identified",    "links"),
     RobotField("Ia",           "array", ("n",),     "drive",     "identified",    "per joint"),
     RobotField("Fv",           "array", ("n",),     "drive",     "identified",    "per joint"),

@@ -44,6 +44,8 @@ class DHModel:
     tool: Array  # (4, 4)
     params: Array  # (n, 10)
     qlim: Array  # (n, 2)
+    velocity_limits: Array  # (n,), inf: none
+    effort_limits: Array  # (n,), inf: none
     Ia: Array  # (n,)
     Fv: Array
     Fs: Array
@@ -84,6 +86,8 @@ def dh_model_from_urdf(
         tool=np.linalg.inv(frames[-1]) @ tip,
         params=_link_parameters(tree, bodies, poses, frames[1:]),
         qlim=np.array([_limits(j) for j in joints]),
+        velocity_limits=np.array([j.velocity_limit for j in joints]),
+        effort_limits=np.array([j.effort_limit for j in joints]),
         Ia=np.array([j.rotor_inertia for j in joints]),
         Fv=np.array([j.damping for j in joints]),
         Fs=np.array([j.friction for j in joints]),

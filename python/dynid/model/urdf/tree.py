@@ -46,6 +46,8 @@ class Joint:
     origin: Array  # (4, 4) joint frame in the parent link frame
     axis: Array  # (3,) unit, joint frame axes (movable joints only)
     limits: tuple[float, float] | None
+    velocity_limit: float  # <limit velocity>, inf when absent, 0 or UNLIMITED and above
+    effort_limit: float  # <limit effort>, the same
     damping: float
     friction: float
     mimic: bool
@@ -251,6 +253,21 @@ def _number(element: ET.Element, attribute: str, where: str, default: str | None
     return float(_floats(element, attribute, 1, default or "", where)[0])
 
 
+#: A velocity or effort limit written by dynid for a limit it does not know (URDF requires the
+#: attributes, and 0 makes Gazebo, PyBullet and ros2_control refuse to move the joint); read
+#: back, this value and anything above it mean no limit.
+UNLIMITED = 1e6
+
+
+def _rate_limit(limit: ET.Element, name: str, where: str) -> float:
+    """<limit velocity|effort>: the value, or inf (no limit) when absent, 0 (what many URDFs
+    write for "not given") or >= UNLIMITED; ValueError naming it when negative."""
+    value = _number(limit, name, where, "0")
+    if value < 0:
+        raise ValueError(f"{where}: {name}={value}, expected a value >= 0")
+    return np.inf if value == 0 or value >= UNLIMITED else value
+
+
 def _origin(element: ET.Element | None, where: str) -> Array:
     pose = np.eye(4)
     pose[:3, :3] = rpy_matrix(*_floats(element, "rpy", 3, "0 0 0", f"{where} <origin>"))
@@ -317,6 +334,10 @@ def _joint(element: ET.Element, links: dict[str, Inertial | None]) -> Joint:
                 f"{where}: <limit lower={lower} upper={upper}>, expected lower < upper"
             )
         limits = (lower, upper)
+    velocity_limit = effort_limit = np.inf
+    if kind in MOVABLE and limit is not None:
+        velocity_limit = _rate_limit(limit, "velocity", f"{where} <limit>")
+        effort_limit = _rate_limit(limit, "effort", f"{where} <limit>")
     dynamics = element.find("dynamics")
     damping = friction = 0.0
     if dynamics is not None:
@@ -338,6 +359,8 @@ def _joint(element: ET.Element, links: dict[str, Inertial | None]) -> Joint:
         _origin(element.find("origin"), where),
         axis,
         limits,
+        velocity_limit,
+        effort_limit,
         damping,
         friction,
         element.find("mimic") is not None,

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from ..joint_frames import joint_frames
 from .consistency import BODY_RULE, JOINT_RULE, check_writable, physical_form
+from .tree import UNLIMITED
 
 if TYPE_CHECKING:
     from typing_extensions import TypeAlias  # typing.TypeAlias is 3.10+
@@ -58,9 +59,13 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         raise ValueError(
             f"name: expected characters that XML 1.0 allows (no control characters), got {name!r}"
         )
-    bad = [joint for joint in robot.joint_names if _NOT_XML.search(joint)]
-    if bad:
-        raise ValueError(f"joint_names: {bad[0]!r} has characters that XML 1.0 does not allow")
+    for field in ("joint_names", "link_names"):
+        bad = [label for label in getattr(robot, field) if _NOT_XML.search(label)]
+        if bad:
+            raise ValueError(f"{field}: {bad[0]!r} has characters that XML 1.0 does not allow")
+    base_link = _free("base_link", robot.link_names)
+    tool_link = _free("tool", robot.link_names)
+    tool_joint_name = _free("tool_joint", robot.joint_names)
     check_writable(robot, "a URDF", "joint <dynamics>", BODY_RULE, JOINT_RULE)
     links = [physical_form(robot.params[i]) for i in range(robot.n)]
     frames = joint_frames(robot)
@@ -69,15 +74,16 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         ET.Comment(
             f" Written by dynid from a {robot.n}-joint {robot.convention}-DH model. Link i's frame "
             "is joint i's frame (z on its axis); the inertial origins give DH frame i's axes. "
-            "Effort and velocity limits are not part of a dynid model (written as 0). "
+            f"Velocity and effort limits the model does not know are written as {UNLIMITED:g} "
+            "(no limit; dynid reads that value back as none): set your arm's. "
         )
     )
-    ET.SubElement(root, "link", name="base_link")
+    ET.SubElement(root, "link", name=base_link)
     for i in range(robot.n):
         parent_to_joint = frames.placements[i]
         offset = frames.dh_offsets[i]  # DH frame i in URDF link i's frame
         mass, com, inertia = links[i]
-        link = ET.SubElement(root, "link", name=f"link{i + 1}")
+        link = ET.SubElement(root, "link", name=robot.link_names[i])
         inertial = ET.SubElement(link, "inertial")
         ET.SubElement(
             inertial,
@@ -95,8 +101,8 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
                 "added to M[i, i]; URDF has no field for it) "
             )
         )
-        ET.SubElement(joint, "parent", link="base_link" if i == 0 else f"link{i}")
-        ET.SubElement(joint, "child", link=f"link{i + 1}")
+        ET.SubElement(joint, "parent", link=base_link if i == 0 else robot.link_names[i - 1])
+        ET.SubElement(joint, "child", link=robot.link_names[i])
         ET.SubElement(
             joint,
             "origin",
@@ -106,19 +112,38 @@ def urdf_text(robot: Any, name: str = "robot") -> str:
         ET.SubElement(joint, "axis", xyz="0 0 1")
         lower, upper = robot.qlim[i]
         ET.SubElement(
-            joint, "limit", lower=_number(lower), upper=_number(upper), effort="0", velocity="0"
+            joint,
+            "limit",
+            lower=_number(lower),
+            upper=_number(upper),
+            effort=_limit(robot.effort_limits[i]),
+            velocity=_limit(robot.velocity_limits[i]),
         )
         ET.SubElement(
             joint, "dynamics", damping=_number(robot.Fv[i]), friction=_number(robot.Fs[i])
         )
-    ET.SubElement(root, "link", name="tool")
-    tool_joint = ET.SubElement(root, "joint", name="tool_joint", type="fixed")
-    ET.SubElement(tool_joint, "parent", link=f"link{robot.n}")
-    ET.SubElement(tool_joint, "child", link="tool")
+    ET.SubElement(root, "link", name=tool_link)
+    tool_joint = ET.SubElement(root, "joint", name=tool_joint_name, type="fixed")
+    ET.SubElement(tool_joint, "parent", link=robot.link_names[-1])
+    ET.SubElement(tool_joint, "child", link=tool_link)
     tool = frames.tool
     ET.SubElement(tool_joint, "origin", xyz=_vector(tool[:3, 3]), rpy=_vector(rpy(tool[:3, :3])))
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _free(name: str, taken: Any) -> str:
+    """``name``, or ``name_dynid`` (then ``name_dynid2``, ...) when the robot's names hold it."""
+    candidate, k = name, 1
+    while candidate in taken:
+        candidate = f"{name}_dynid{k if k > 1 else ''}"
+        k += 1
+    return candidate
+
+
+def _limit(value: float) -> str:
+    """A velocity or effort limit: UNLIMITED for none (inf), never 0."""
+    return _number(value) if np.isfinite(value) else f"{UNLIMITED:g}"
 
 
 def write_urdf(text: str, path: str | Path, overwrite: bool = False) -> Path:
