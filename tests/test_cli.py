@@ -195,3 +195,18 @@ def test_identify_position_torque(files, tmp_path, capsys):
     np.testing.assert_allclose(result.theta[-2:], [0.3, -0.2], rtol=0, atol=1e-9)
     options = json.loads((out / "result.json").read_text())["options"]
     assert options["position_torque_joints"] == [2]
+
+
+def test_python_m_dynid_is_the_command() -> None:
+    """``python -m dynid`` runs the ``dynid`` command (environments without the script)."""
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-m", "dynid", "info", "--model", "planar_2r"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("planar 2R")

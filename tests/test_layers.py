@@ -25,7 +25,7 @@ LAYERS: list[set[str]] = [
     {"identification"},
     {"export"},
     {"cli"},
-    {"__init__", "io"},  # the facades: the public names, re-exported
+    {"__init__", "__main__", "io"},  # the facades: the public names, re-exported; python -m dynid
 ]
 #: The layers whose parts may import each other: the foundation (the checks use the C++ core)
 #: and the facades.

@@ -108,7 +108,8 @@ def _links(robot: Robot, field: RobotField) -> list[str]:
 
 
 def _per_joint(robot: Robot, field: RobotField) -> list[str]:
-    return [f"  {field.key}: " + " ".join(f"{v:.4g}" for v in getattr(robot, field.attribute))]
+    label = field.label or field.key
+    return [f"  {label}: " + " ".join(f"{v:.4g}" for v in getattr(robot, field.attribute))]
 
 
 def _names(robot: Robot, field: RobotField) -> list[str]:

@@ -148,9 +148,9 @@ FIELDS: tuple[RobotField, ...] = (
                label="qmin qmax"),
     # inf: not known, not limited (the default); files write it as null (dynid.model.model_files).
     RobotField("velocity_limits", "limits", ("n",), "limits",    "omit_default",  "per joint",
-               label="velocity limits"),
+               label="velocity limits [rad/s, m/s]"),
     RobotField("effort_limits", "limits", ("n",),   "limits",    "omit_default",  "per joint",
-               label="effort limits"),
+               label="effort limits [N m, N]"),
     RobotField("params",       "array", ("n", 10),  "links",     "identified",    "links"),
     RobotField("Ia",           "array", ("n",),     "drive",     "identified",    "per joint"),
     RobotField("Fv",           "array", ("n",),     "drive",     "identified",    "per joint"),
