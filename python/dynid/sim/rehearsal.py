@@ -96,7 +96,7 @@ def rehearse(
     bandwidth = _positive(bandwidth, "bandwidth")
     sensor_noise = _nonnegative(sensor_noise, "sensor_noise")
     dt = 1.0 / rate
-    periods = max(1, int(round(_positive(duration, "duration") * rate)))
+    periods = max(1, round(_positive(duration, "duration") * rate))
     model = robot if controller_model is None else controller_model
     q0, qd0, _ = (np.asarray(v, dtype=float) for v in reference(np.zeros(1)))
     q0, qd0 = q0.reshape(-1), qd0.reshape(-1)
