@@ -51,7 +51,7 @@ def test_bad_arguments_are_named(arm_log, tmp_path) -> None:
     with pytest.raises(ValueError, match="storage: expected one of mcap, sqlite3"):
         write_ros_bag(log, tmp_path / "b", arm.joint_names, storage="zip")
     (tmp_path / "c").mkdir()
-    with pytest.raises(ValueError, match="path: .* exists"):
+    with pytest.raises(ValueError, match=r"path: .* exists"):
         write_ros_bag(log, tmp_path / "c", arm.joint_names)
     with pytest.raises(ValueError, match="topic: expected a topic name"):
         write_ros_bag(log, tmp_path / "d", arm.joint_names, topic="joint_states")
