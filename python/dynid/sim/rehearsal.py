@@ -1,5 +1,6 @@
 """A dry run of an identification experiment: the arm tracks the exciting trajectory under its
-controller, and what its sensors would record comes out (issue 21, item 2; docs/workflow.md).
+controller, and what its sensors would record comes out (issue 21, item 2; docs/uses.md,
+"A dry run of the experiment").
 
 The plant is :func:`dynid.sim.simulate` (the C++ closed loop at the controller rate, RK4
 substeps, the robot's friction). What is recorded is what a real controller logs:
