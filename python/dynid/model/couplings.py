@@ -100,14 +100,14 @@ def dynamic_structure(
     low, high = robot.qlim[:, 0], robot.qlim[:, 1]
     base = rng.uniform(low, high, (samples, n))
     B, g = robot.mass_matrix(base), robot.gravity(base)
-    scale_B = max(float(np.abs(B).max()), np.finfo(float).tiny)
+    scale_B = max(float(np.abs(B).max()), float(np.finfo(float).tiny))
     # Gravity torques are measured against |g0| times the total mass times the arm's reach (a
     # torque g could have), not against the largest g found: g = 0 up to rounding must be zero.
     reach = max(1e-3, float(np.abs(robot.dh[:, [0, 2]]).sum()))
     weight = float(np.linalg.norm(robot.gravity_vector)) * float(np.abs(robot.params[:, 0]).sum())
-    scale_g = max(weight * reach, float(np.abs(g).max()), np.finfo(float).tiny)
-    depends_B = np.zeros((n, n, n), dtype=bool)  # [i, j, k]: B_ij depends on q_k
-    depends_g = np.zeros((n, n), dtype=bool)  # [i, k]: g_i depends on q_k
+    scale_g = max(weight * reach, float(np.abs(g).max()), float(np.finfo(float).tiny))
+    depends_B: NDArray[np.bool_] = np.zeros((n, n, n), dtype=bool)  # [i, j, k]: B_ij depends on q_k
+    depends_g: NDArray[np.bool_] = np.zeros((n, n), dtype=bool)  # [i, k]: g_i depends on q_k
     zero_B = np.all(np.abs(B) <= tolerance * scale_B, axis=0)
     zero_g = np.all(np.abs(g) <= tolerance * scale_g, axis=0)
     for k in range(n):
