@@ -124,3 +124,28 @@ def cartesian_dynamics(
     mu = (Lam @ ((Yt @ c[..., None])[..., 0] - Jdot_qd)[..., None])[..., 0]
     p = (Lam @ (Yt @ g[..., None]))[..., 0]
     return Lam, mu, p
+
+
+def cartesian_coriolis_matrix(
+    robot: Robot, q: ArrayLike, qd: ArrayLike, rows: str | Sequence[int] | None = None
+) -> Array:
+    """S_p = J^-T (S - M J^-1 Jdot) J^-1: the factorization mu = S_p xd of the Cartesian
+    Coriolis/centrifugal force, xd = J qd, for a square Jacobian (as many task rows as joints;
+    notes p. 49), (k, k) per sample. S is the joint-space factorization of
+    ``robot.coriolis_matrix`` (Christoffel symbols), with which Mdot - 2 S is skew-symmetric;
+    then so is Lamdot - 2 S_p (Lam = J^-T M J^-1): Lamdot - 2 S_p = J^-T (Mdot - 2 S) J^-1.
+    ValueError naming ``rows`` when J is not square, ``q`` at a singularity."""
+    q_array = real_array(q, "q")
+    selected = task_rows(rows)
+    if len(selected) != robot.n:
+        raise ValueError(
+            f"rows: the Cartesian factorization S_p needs a square Jacobian: {robot.n} task rows "
+            f"for {robot.n} joints, got {len(selected)} ({selected})"
+        )
+    J, M, Y = _task_mobility(robot, q_array, selected)
+    _inverse_checked(J @ Y, selected)  # the singularity check of cartesian_inertia
+    S = robot.coriolis_matrix(q_array, qd)  # checks qd against q
+    Jdot = robot.jacobian_dot(q_array, qd)[..., selected, :]
+    J_inv = np.asarray(np.linalg.inv(J), dtype=np.float64)
+    J_inv_t = np.swapaxes(J_inv, -1, -2)
+    return np.asarray(J_inv_t @ (S - M @ J_inv @ Jdot) @ J_inv, dtype=np.float64)

@@ -327,6 +327,13 @@ class Robot(_core.Model):
         :mod:`dynid.model.operational_space`."""
         return operational_space.cartesian_dynamics(self, q, qd, rows)
 
+    def cartesian_coriolis_matrix(
+        self, q: ArrayLike, qd: ArrayLike, rows: str | Sequence[int] | None = None
+    ) -> NDArray[np.float64]:
+        """S_p with mu = S_p xd and Lamdot - 2 S_p skew-symmetric (notes p. 49), for a square
+        Jacobian (n task rows). See :mod:`dynid.model.operational_space`."""
+        return operational_space.cartesian_coriolis_matrix(self, q, qd, rows)
+
     def random_configurations(self, count: int, seed: int | None = 0) -> NDArray[np.float64]:
         """``count`` configurations drawn uniformly within the joint limits, (count, n)."""
         count = checks.count(count, "count", 0, "a number of configurations")
