@@ -23,7 +23,7 @@ def test_lamdot_minus_2sp_is_skew_and_sp_factors_mu(name, rows, q) -> None:
     q = np.array(q)
     qd = np.linspace(0.3, -0.5, robot.n)
     Sp = robot.cartesian_coriolis_matrix(q, qd, rows=rows)
-    Lam, mu, _ = robot.cartesian_dynamics(q, qd, rows=rows)
+    _, mu, _ = robot.cartesian_dynamics(q, qd, rows=rows)
     J = robot.jacobian(q)[list(rows) if rows else slice(None)]
     xd = J @ qd
     assert np.max(np.abs(Sp @ xd - mu)) <= 1e-10 * max(1.0, np.abs(mu).max())
