@@ -20,7 +20,16 @@ def _arm(seed: int, gravity=(0.0, -9.81, 0.0)):
     m1, m2 = rng.uniform(0.5, 5.0, 2)
     I1, I2 = rng.uniform(0.01, 0.3, 2)
     robot = dynid.models.planar_2r(l1, l2, lc1, lc2, m1, m2, I1, I2, gravity=gravity)
-    return robot, dict(l1=l1, l2=l2, d1=lc1, d2=lc2, m1=m1, m2=m2, Ic1=I1, Ic2=I2)
+    return robot, {
+        "l1": l1,
+        "l2": l2,
+        "d1": lc1,
+        "d2": lc2,
+        "m1": m1,
+        "m2": m2,
+        "Ic1": I1,
+        "Ic2": I2,
+    }
 
 
 def _states(seed: int, T: int = 50):

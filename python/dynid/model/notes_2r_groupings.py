@@ -134,6 +134,8 @@ def notes_2r_grouping(robot: Robot, name: str = "notes_2r") -> Grouping:
 
     a1 = row(inertia(0)) + row(inertia(1)) + row({m[1]: l1**2})
     a3 = row(inertia(1))
+    names: tuple[str, ...]
+    expressions: tuple[str, ...]
     if name == "notes_2r":
         beta = np.stack([a1, row(md(1)), a3, row(md(0)) + row({m[1]: l1})])
         names = ("a1", "a2", "a3", "a4")
