@@ -19,7 +19,12 @@ from dynid.cli.demo import LINK_FRICTION, TIP_MASS, controller_model, run_demo
 from dynid.export.output_folder import MARKER
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-PLOTS = ("fig3_joint_motion.png", "fig4_torques.png", "fig6_g2_M11.png")
+PLOTS = (
+    "fig3_joint_motion.png",
+    "fig4_torques.png",
+    "fig5_final_validation_motion.png",
+    "fig6_g2_M11.png",
+)
 
 
 def png_size(path) -> tuple[int, int]:
@@ -117,7 +122,7 @@ def test_demo_reports_the_zero_element_and_the_tables(demo):
     assert "tracking error" in text
 
 
-def test_demo_writes_three_png_plots(demo):
+def test_demo_writes_four_png_plots(demo):
     out, report, _ = demo
     assert sorted(report["plots"]) == sorted(PLOTS)
     for name in PLOTS:
@@ -164,3 +169,16 @@ def test_cli_rejects_an_unknown_command(capsys):
     with pytest.raises(SystemExit) as info:
         dynid.cli.main(["nonsense"])
     assert info.value.code != 0
+
+
+def test_final_validation_experiment_of_fig5(demo):
+    """The paper's Fig. 5 experiment: 500 readings of g(q) and M(q) along a minute of sinusoids;
+    the identified model matches them as it matches the random validation set (the same
+    controller noise: within twice the validation set's largest error)."""
+    _, report, lines = demo
+    final = report["final_validation"]
+    assert final["samples"] == 500
+    gravity_vs = max(v for v in report["gravity_errors"]["VS"]["max_abs"] if v is not None)
+    assert max(final["gravity_max_abs"][1:]) <= 2 * gravity_vs
+    assert final["inertia_max_abs"] <= 2 * report["inertia_errors"]["VS"]["max_abs"]
+    assert any("final validation (Fig. 5)" in line for line in lines)

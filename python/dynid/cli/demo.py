@@ -10,7 +10,9 @@
 4. A second arm carries a 250 g tip on the flange; the payload mass is estimated from the change
    of the two coefficients that hold d1 (m3+...+m7) and d2 (m5+m6+m7) (eqs. (31)-(32)).
 5. The torque validation experiment of eq. (33), positions differentiated numerically and
-   filtered by a 4th-order zero-phase Butterworth at 1 Hz; plots like Figs. 3, 4 and 6. The
+   filtered by a 4th-order zero-phase Butterworth at 1 Hz, and the final validation experiment
+   (Sect. VI, Fig. 5: sinusoids on every joint for a minute, g(q) and M(q) read every 120 ms
+   and compared element by element); plots like Figs. 3, 4, 5 and 6. The
    identified model has no friction, so its torques miss the link-side friction in tau_J, as on
    the real robot (paper Sect. VI: "unmodeled dynamics, especially static friction").
 """
@@ -37,6 +39,11 @@ from ..logs.signal import differentiate, lowpass
 from ..model import models
 from ..model.robot import Robot
 from ..sim import StaticReadings, TorqueRecording, VirtualController, paper_validation_trajectory
+from ..sim.virtual_controller import (
+    FIG5_DURATION,
+    FIG5_SAMPLE_TIME,
+    paper_final_validation_trajectory,
+)
 
 #: Fewest training configurations `dynid demo` accepts. The LWR-IV's 12 gravity coefficients are
 #: fitted on 6 rows per configuration (joint 1's gravity row is left out), so 2 configurations
@@ -182,6 +189,25 @@ def run_demo(
         f" over {len(ident.inertia_base.names)} coefficients"
     )
 
+    # The final validation experiment (Sect. VI, Fig. 5): sinusoids on every joint for a
+    # minute, the controller's g(q) and M(q) read every 120 ms against the identified model's.
+    t_fig5 = np.arange(round(FIG5_DURATION / FIG5_SAMPLE_TIME)) * FIG5_SAMPLE_TIME
+    final = controller.read_static(paper_final_validation_trajectory(t_fig5)[0])
+    g_final, M_final = ident.gravity(final.q), ident.mass_matrix(final.q)
+    rows, columns = np.tril_indices(truth.n)  # the 7 + 28 distinct elements of g and M
+    final_errors = {
+        "samples": int(t_fig5.size),
+        "gravity_max_abs": [float(e) for e in np.abs(final.g - g_final).max(axis=0)],
+        "inertia_max_abs": float(
+            np.abs(final.M[:, rows, columns] - M_final[:, rows, columns]).max()
+        ),
+    }
+    progress(
+        f"  final validation (Fig. 5): {t_fig5.size} readings over {FIG5_DURATION:g} s of "
+        f"sinusoids, max |error| over the 35 elements: g {max(final_errors['gravity_max_abs']):.3g}"
+        f" N m, M {final_errors['inertia_max_abs']:.3g} kg m^2"
+    )
+
     # 5. A second arm with the 250 g tip.
     tip_controller = VirtualController(
         truth.with_payload(TIP_MASS, TIP_COM, TIP_INERTIA),
@@ -220,16 +246,19 @@ def run_demo(
                 staging / "fig4_torques.png",
                 "Sensed joint torques (filtered) and estimated torques, eq. (26)",
             ),
+            plots.plot_joint_signals(
+                t_fig5,
+                *paper_final_validation_trajectory(t_fig5),
+                staging / "fig5_final_validation_motion.png",
+                "Final validation experiment: sinusoids on every joint (Fig. 5)",
+            ),
             plots.plot_element_comparison(
                 {
-                    "g_2(q) [N m]": (checking.g[:, 1], ident.gravity(checking.q)[:, 1]),
-                    "M_11(q) [kg m^2]": (
-                        checking.M[:, 0, 0],
-                        ident.mass_matrix(checking.q)[:, 0, 0],
-                    ),
+                    "g_2(q) [N m]": (final.g[:, 1], g_final[:, 1]),
+                    "M_11(q) [kg m^2]": (final.M[:, 0, 0], M_final[:, 0, 0]),
                 },
                 staging / "fig6_g2_M11.png",
-                "Validation set: controller values and identified model",
+                "Final validation (Fig. 5 motion): controller values and identified model",
             ),
         ]
         report = {
@@ -248,6 +277,7 @@ def run_demo(
             "zero_elements": [vars(z) for z in ident.zero_elements],
             "gravity_errors": {"TS": _lists(g_ts), "VS": _lists(g_vs), "TVE": _lists(tve)},
             "inertia_errors": {"TS": m_ts, "VS": m_vs},
+            "final_validation": final_errors,
             "condition_numbers": {
                 "gravity": ident.gravity_fit.condition_number,
                 "inertia": ident.inertia_fit.condition_number,

@@ -11,6 +11,8 @@
   same way (C++ RK4, zero-order hold; zero torque, :class:`MotorPD`, the KUKA-like joint torque
   controller :class:`KukaLike` or a Python controller):
   :mod:`~dynid.sim.elastic_joints`.
+- :func:`rehearse` is a dry run of an identification experiment: the arm tracks the trajectory
+  and what its controller would log comes out (:mod:`~dynid.sim.rehearsal`).
 """
 
 from .closed_loop import Simulation, plant_friction, simulate
@@ -20,8 +22,10 @@ from .virtual_controller import (
     StaticReadings,
     TorqueRecording,
     VirtualController,
+    paper_final_validation_trajectory,
     paper_validation_trajectory,
 )
+from .rehearsal import Rehearsal, rehearse
 
 __all__ = [
     "PD",
@@ -30,12 +34,15 @@ __all__ = [
     "KukaLike",
     "MotorPD",
     "PDGravity",
+    "Rehearsal",
     "Simulation",
     "StaticReadings",
     "TorqueRecording",
     "VirtualController",
+    "paper_final_validation_trajectory",
     "paper_validation_trajectory",
     "plant_friction",
+    "rehearse",
     "simulate",
     "simulate_elastic",
 ]

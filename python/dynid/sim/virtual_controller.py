@@ -429,3 +429,26 @@ def paper_validation_trajectory(
     qdd = -amplitude * w**2 * np.cos(w * t)
     ones = np.ones((1, n))
     return q * ones, qd * ones, qdd * ones
+
+
+#: The final validation experiment of the paper (Sect. VI, Fig. 5): "sinusoidal reference
+#: trajectories of different frequency and amplitude have been imposed during 1 minute to each
+#: joint", M(q) and g(q) read from FRI every 120 ms (500 samples). The paper shows the motion only
+#: as a figure: these amplitudes [rad] and periods [s] are ours, within the LWR-IV's ranges.
+FIG5_AMPLITUDES = (0.9, 0.8, 1.0, 1.1, 1.2, 1.0, 1.5)
+FIG5_PERIODS = (30.0, 20.0, 15.0, 12.0, 10.0, 7.5, 6.0)
+#: Its sampling: every 120 ms for one minute.
+FIG5_SAMPLE_TIME = 0.12
+FIG5_DURATION = 60.0
+
+
+def paper_final_validation_trajectory(
+    t: NDArray[np.float64],
+) -> tuple[NDArray, NDArray, NDArray]:
+    """The 7 joints' sinusoids of the paper's final validation experiment (Fig. 5): joint j
+    follows A_j sin(2 pi t / T_j) with ``FIG5_AMPLITUDES`` and ``FIG5_PERIODS``; (q, qd, qdd),
+    (T, 7) each."""
+    a = np.asarray(FIG5_AMPLITUDES)
+    w = 2.0 * np.pi / np.asarray(FIG5_PERIODS)
+    t = np.asarray(t, dtype=float)[:, None]
+    return a * np.sin(w * t), a * w * np.cos(w * t), -a * w**2 * np.sin(w * t)
