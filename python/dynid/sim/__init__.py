@@ -18,6 +18,7 @@
 from .closed_loop import Simulation, plant_friction, simulate
 from .controllers import PD, ComputedTorque, PDGravity
 from .elastic_joints import ElasticSimulation, KukaLike, MotorPD, simulate_elastic
+from .rehearsal import Rehearsal, rehearse
 from .virtual_controller import (
     StaticReadings,
     TorqueRecording,
@@ -25,7 +26,6 @@ from .virtual_controller import (
     paper_final_validation_trajectory,
     paper_validation_trajectory,
 )
-from .rehearsal import Rehearsal, rehearse
 
 __all__ = [
     "PD",
