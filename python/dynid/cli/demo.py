@@ -195,17 +195,17 @@ def run_demo(
     final = controller.read_static(paper_final_validation_trajectory(t_fig5)[0])
     g_final, M_final = ident.gravity(final.q), ident.mass_matrix(final.q)
     rows, columns = np.tril_indices(truth.n)  # the 7 + 28 distinct elements of g and M
+    gravity_final = np.abs(final.g - g_final).max(axis=0)
+    inertia_final = float(np.abs(final.M[:, rows, columns] - M_final[:, rows, columns]).max())
     final_errors = {
         "samples": int(t_fig5.size),
-        "gravity_max_abs": [float(e) for e in np.abs(final.g - g_final).max(axis=0)],
-        "inertia_max_abs": float(
-            np.abs(final.M[:, rows, columns] - M_final[:, rows, columns]).max()
-        ),
+        "gravity_max_abs": [float(e) for e in gravity_final],
+        "inertia_max_abs": inertia_final,
     }
     progress(
         f"  final validation (Fig. 5): {t_fig5.size} readings over {FIG5_DURATION:g} s of "
-        f"sinusoids, max |error| over the 35 elements: g {max(final_errors['gravity_max_abs']):.3g}"
-        f" N m, M {final_errors['inertia_max_abs']:.3g} kg m^2"
+        f"sinusoids, max |error| over the 35 elements: g {gravity_final.max():.3g} N m, "
+        f"M {inertia_final:.3g} kg m^2"
     )
 
     # 5. A second arm with the 250 g tip.
