@@ -106,6 +106,7 @@ def _add_identify(subcommands: Any) -> None:
     _add_preparation(p)
     _add_motor_side(p)
     _add_output(p, "dynid-identify")
+    _add_report(p)
     p.set_defaults(run=commands.identify)
 
 
@@ -138,6 +139,7 @@ def _add_validate(subcommands: Any) -> None:
     )
     _add_config(p)
     _add_output(p, "dynid-validate")
+    _add_report(p)
     p.set_defaults(run=commands.validate)
 
 
@@ -287,6 +289,16 @@ def _add_output(p: argparse.ArgumentParser, default: str) -> None:
         "--overwrite",
         action="store_true",
         help="replace the output folder if it exists and is not empty",
+    )
+
+
+def _add_report(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--report",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="write report.html, the run's figures and tables in one page for a browser "
+        "(default: on; --no-report saves its 1-2 s on a 7-joint arm)",
     )
 
 
