@@ -262,7 +262,7 @@ def _parameter_section(result: LogIdentification, title: str = "Coefficients") -
         )
     ]
     headers = ["coefficient", "value", "± std", "relative std", "expression"]
-    body = table(headers, rows, "parameters") + (
+    body = table(headers, rows, "parameter-table") + (
         "<p>Values in SI units as their expressions over the standard parameters (result.json, "
         "<code>units</code>); a dash: no standard deviation (a physically consistent fit) or "
         "a relative one of a zero value.</p>"
@@ -289,15 +289,15 @@ def _metrics_section(
             if extra:
                 row.append(Num(np.asarray(training_relative_rms, dtype=float)[j], 6))
             rows.append(row)
-        tables.append(table(headers, rows, "metrics" if k == 0 else f"metrics-log{k}", caption))
+        tables.append(table(headers, rows, "metrics-table" if k == 0 else f"metrics-table-log{k}", caption))
     return Section("metrics", "Errors per joint", "\n".join(tables))
 
 
 def _notes_section(warnings: Sequence[str], notes: Sequence[str]) -> Section:
     body = (
         "<h3>Warnings</h3>"
-        + bullet_list(warnings, "warnings")
+        + bullet_list(warnings, "warning-list")
         + "<h3>Notes (reading and preparing the log, the fit)</h3>"
-        + bullet_list(notes, "notes")
+        + bullet_list(notes, "note-list")
     )
     return Section("notes", "Warnings and notes", body)
