@@ -73,8 +73,17 @@ def envelope_with_gaps(
         if kept.size:
             index.extend(_extremes(y, kept))
 
-    for lo in range(0, y.size, size):
+    # The extremes of the whole buckets at once (those with holes are redone below).
+    whole = y.size // size
+    body = np.where(finite, y, 0.0)[: whole * size].reshape(whole, size)
+    start = np.arange(whole) * size
+    lowest, highest = start + body.argmin(axis=1), start + body.argmax(axis=1)
+    clean = finite[: whole * size].reshape(whole, size).all(axis=1)
+    for k, lo in enumerate(range(0, y.size, size)):
         hi = min(lo + size, y.size)
+        if k < whole and clean[k]:
+            index.extend(sorted({int(lowest[k]), int(highest[k])}))
+            continue
         holes = lo + np.flatnonzero(~finite[lo:hi])
         if holes.size == 0:
             extremes_of(lo, hi)
@@ -142,17 +151,19 @@ def torque_figure(
 
 
 def histogram_figure(residual: ArrayLike, label: str, gid: str) -> str:
-    """The histogram of one joint's residuals (predicted - measured, the rows kept); the bars'
-    SVG group is ``{gid}-bars``."""
+    """The histogram of one joint's residuals (predicted - measured, the rows kept); its SVG
+    group is ``{gid}-bars``."""
     residual = np.asarray(residual, dtype=float)
     residual = residual[np.isfinite(residual)]
     fig = Figure(figsize=(4.2, 2.6))
     fig.subplots_adjust(left=0.17, right=0.97, top=0.87, bottom=0.2)
     ax = fig.add_subplot()
     bins = int(np.clip(round(np.sqrt(residual.size)), MIN_BINS, MAX_BINS))
-    _, _, bars = ax.hist(residual, bins=bins, color="tab:red", alpha=0.8)
-    for k, bar in enumerate(bars):
-        bar.set_gid(f"{gid}-bar{k}")
+    # One filled outline (stairs) instead of a bar per bin: one SVG path, and drawn in a
+    # fraction of the time of ``hist``'s bars.
+    counts, edges = np.histogram(residual, bins=bins)
+    bars = ax.stairs(counts, edges, fill=True, color="tab:red", alpha=0.8)
+    bars.set_gid(f"{gid}-bars")
     ax.axvline(0.0, color="k", lw=0.6)
     ax.set_title(label, fontsize=10)
     ax.set_xlabel("predicted - measured [N m]")
