@@ -253,11 +253,8 @@ def test_validate_report_has_its_errors_the_result_and_the_warning(runs_done) ->
     report = json.loads((valid / "validation.json").read_text())
     data = json.loads((ident / "result.json").read_text())
     n = len(report["metrics"]["rms"])
-    assert [s.attrs["id"] for s in page.iter("section")] == SECTIONS[:3] + [
-        "metrics",
-        "parameters",
-        "notes",
-    ]
+    order = [*SECTIONS[:3], "metrics", "parameters", "notes"]
+    assert [s.attrs["id"] for s in page.iter("section")] == order
     for j in range(1, n + 1):
         assert len(list(page.find(f"torque-log1-j{j}").iter("svg"))) == 1
         assert len(list(page.find(f"histogram-j{j}").iter("svg"))) == 1
@@ -365,3 +362,23 @@ def test_report_of_a_long_log_stays_small(tmp_path) -> None:
 def test_write_report_refuses_what_it_cannot_report(tmp_path) -> None:
     with pytest.raises(ValueError, match=r"^result_or_validation: expected"):
         write_report("result.json", tmp_path)  # type: ignore[arg-type]
+
+
+def test_the_python_functions_write_it_only_when_asked(runs_done, tmp_path) -> None:
+    """save_result and save_validation as before by default (no report.html); report=True adds
+    it, and a result read from its file (no log kept) says so in place of the figures."""
+    from dynid.export.result_files import load_result, save_result, save_validation
+    from dynid.identification.log_identification import run_validation
+
+    result = load_result(runs_done["ident"])
+    validation = run_validation(result, runs_done["check"])
+    save_validation(validation, tmp_path / "v")
+    save_result(result, tmp_path / "r")
+    assert not (tmp_path / "v" / REPORT_FILE).exists()
+    assert not (tmp_path / "r" / REPORT_FILE).exists()
+    save_validation(validation, tmp_path / "v2", report=True, result=result)
+    save_result(result, tmp_path / "r2", report=True)
+    assert (tmp_path / "v2" / REPORT_FILE).is_file()
+    page = parse(tmp_path / "r2" / REPORT_FILE)
+    assert "No log kept" in page.find("torques").text and not list(page.iter("svg"))
+    assert len(table_rows(page, "parameter-table")) == result.theta.size

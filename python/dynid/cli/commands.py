@@ -217,7 +217,8 @@ def _identify(args: argparse.Namespace, seen: list[str]) -> None:
     )
     step(
         f"wrote {path}, {path.parent / RUN_FILE}, {path.parent / 'torques.png'}, "
-        f"{path.parent / 'residuals.png'}" + (" (and per log)" if len(logs) > 1 else "")
+        f"{path.parent / 'residuals.png'}"
+        + (" (and per log)" if len(logs) > 1 else "")
         + _report_written(args, path)
     )
 
@@ -420,7 +421,7 @@ def _validate(args: argparse.Namespace, seen: list[str]) -> None:
 
 
 def _report_written(args: argparse.Namespace, path: Any) -> str:
-    """", FOLDER/report.html" when the command wrote it (not with --no-report)."""
+    """ ", FOLDER/report.html" when the command wrote it (not with --no-report)."""
     return f", {path.parent / 'report.html'}" if args.report else ""
 
 

@@ -153,15 +153,15 @@ def torque_figure(
 def histogram_figure(residual: ArrayLike, label: str, gid: str) -> str:
     """The histogram of one joint's residuals (predicted - measured, the rows kept); its SVG
     group is ``{gid}-bars``."""
-    residual = np.asarray(residual, dtype=float)
-    residual = residual[np.isfinite(residual)]
+    values = np.asarray(residual, dtype=float)
+    values = values[np.isfinite(values)]
     fig = Figure(figsize=(4.2, 2.6))
     fig.subplots_adjust(left=0.17, right=0.97, top=0.87, bottom=0.2)
     ax = fig.add_subplot()
-    bins = int(np.clip(round(np.sqrt(residual.size)), MIN_BINS, MAX_BINS))
+    bins = int(np.clip(round(np.sqrt(values.size)), MIN_BINS, MAX_BINS))
     # One filled outline (stairs) instead of a bar per bin: one SVG path, and drawn in a
     # fraction of the time of ``hist``'s bars.
-    counts, edges = np.histogram(residual, bins=bins)
+    counts, edges = np.histogram(values, bins=bins)
     bars = ax.stairs(counts, edges, fill=True, color="tab:red", alpha=0.8)
     bars.set_gid(f"{gid}-bars")
     ax.axvline(0.0, color="k", lw=0.6)

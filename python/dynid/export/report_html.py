@@ -55,7 +55,9 @@ def table(
     head = "".join(f"<th>{text(h)}</th>" for h in headers)
     body = "\n".join(
         "<tr>"
-        + "".join(cell.html() if isinstance(cell, Num) else f"<td>{text(cell)}</td>" for cell in row)
+        + "".join(
+            cell.html() if isinstance(cell, Num) else f"<td>{text(cell)}</td>" for cell in row
+        )
         + "</tr>"
         for row in rows
     )
@@ -88,9 +90,7 @@ def bullet_list(items: Iterable[str], list_id: str, empty: str = "none") -> str:
 
 def figure(svg: str, figure_id: str, caption: str) -> str:
     """An inline SVG with a caption (the SVG is matplotlib's, its texts escaped by it)."""
-    return (
-        f'<figure id="{text(figure_id)}">{svg}<figcaption>{text(caption)}</figcaption></figure>'
-    )
+    return f'<figure id="{text(figure_id)}">{svg}<figcaption>{text(caption)}</figcaption></figure>'
 
 
 @dataclass(frozen=True)

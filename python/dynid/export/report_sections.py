@@ -50,7 +50,9 @@ def identification_sections(
         _histogram_section(runs, names),
         _parameter_section(result),
     ]
-    metrics = [("fit on the training log" + ("s" if training.get("logs") else ""), training)]
+    metrics: list[tuple[str, Mapping[str, Any]]] = [
+        ("fit on the training log" + ("s" if training.get("logs") else ""), training)
+    ]
     metrics += [(f"fit on log {k}, {run.get('source')}", run) for k, run in _logs(training)]
     sections.append(_metrics_section(metrics, names))
     notes = list(training.get("notes", []))
@@ -184,7 +186,9 @@ def _identification_facts(result: LogIdentification) -> list[tuple[str, Any]]:
         ("condition number", Num(result.condition_number, 6)),
     ]
     if result.excluded:
-        items.append(("joints left out of the fit", ", ".join(f"J{j + 1}" for j in result.excluded)))
+        items.append(
+            ("joints left out of the fit", ", ".join(f"J{j + 1}" for j in result.excluded))
+        )
     if result.physical is not None:
         report = result.physical
         items.append(
@@ -289,7 +293,9 @@ def _metrics_section(
             if extra:
                 row.append(Num(np.asarray(training_relative_rms, dtype=float)[j], 6))
             rows.append(row)
-        tables.append(table(headers, rows, "metrics-table" if k == 0 else f"metrics-table-log{k}", caption))
+        tables.append(
+            table(headers, rows, "metrics-table" if k == 0 else f"metrics-table-log{k}", caption)
+        )
     return Section("metrics", "Errors per joint", "\n".join(tables))
 
 

@@ -128,7 +128,7 @@ def save_validation(
     applied, its coefficients and training errors; ``report_warnings`` listed).
     ``overwrite`` never replaces a folder that holds ``result_source`` or the log's file
     (:mod:`dynid.export.output_folder`)."""
-    report = {
+    record = {
         "format": VALIDATION_FORMAT,
         "version": VALIDATION_VERSION,
         "dynid_version": dynid_version(),
@@ -143,7 +143,7 @@ def save_validation(
     inputs = [result_source, log_source, validation.log.source]
     _check_file_names(files, VALIDATION_FILE)
     with output_folder(folder, overwrite, inputs=inputs) as staging:
-        (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
+        (staging / VALIDATION_FILE).write_text(dumps_json(record) + "\n")
         for name, text in (files or {}).items():
             (staging / name).write_text(text)
         if plots:
