@@ -382,3 +382,22 @@ def test_the_python_functions_write_it_only_when_asked(runs_done, tmp_path) -> N
     page = parse(tmp_path / "r2" / REPORT_FILE)
     assert "No log kept" in page.find("torques").text and not list(page.iter("svg"))
     assert len(table_rows(page, "parameter-table")) == result.theta.size
+
+
+def test_several_training_logs_each_get_their_figures_and_errors(runs_done, tmp_path) -> None:
+    """identify on two logs: a torque figure per joint and log, the errors on all samples and
+    on each log, as result.json's training.metrics and training.logs[k].metrics."""
+    folder = runs_done["folder"]
+    out = tmp_path / "two"
+    argv = ["identify", str(folder / "train.npz"), str(folder / "check.npz")]
+    assert main([*argv, "--model", str(folder / "arm.json"), "--output", str(out)]) == 0
+    page = parse(out / REPORT_FILE)
+    data = json.loads((out / "result.json").read_text())
+    for k in (1, 2):
+        for j in (1, 2):
+            assert len(list(page.find(f"torque-log{k}-j{j}").iter("svg"))) == 1
+        rows = table_rows(page, f"metrics-table-log{k}")
+        for j, cells in enumerate(rows):
+            check_number(cells[1], data["training"]["logs"][k - 1]["metrics"]["rms"][j])
+    for j, cells in enumerate(table_rows(page, "metrics-table")):
+        check_number(cells[1], data["training"]["metrics"]["rms"][j])
