@@ -298,7 +298,7 @@ def _add_report(p: argparse.ArgumentParser) -> None:
         action=argparse.BooleanOptionalAction,
         default=True,
         help="write report.html, the run's figures and tables in one page for a browser "
-        "(default: on; --no-report saves its 1-2 s on a 7-joint arm)",
+        "(default: on; --no-report saves its 1-1.5 s of CPU on a 7-joint arm)",
     )
 
 
