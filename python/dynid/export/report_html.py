@@ -40,11 +40,12 @@ class Num:
     digits: int = 6
     suffix: str = ""
 
-    def html(self) -> str:
+    def html(self, tag: str = "td") -> str:
+        """The element ``tag`` (a table cell, or e.g. "dd") holding the number."""
         finite = _finite(self.value)
         exact = "null" if finite is None else repr(finite)
         shown = number(finite, self.digits) + (self.suffix if finite is not None else "")
-        return f'<td class="num" data-value="{exact}">{text(shown)}</td>'
+        return f'<{tag} class="num" data-value="{exact}">{text(shown)}</{tag}>'
 
 
 def table(
@@ -73,11 +74,7 @@ def facts(items: Iterable[tuple[str, Any]], list_id: str) -> str:
     printed as one, with its exact value in ``data-value``."""
     lines = []
     for label, value in items:
-        if isinstance(value, Num):
-            cell = value.html()  # "<td ...>x</td>": the same attributes on a <dd>
-            shown = f"<dd{cell[3:-5]}</dd>"
-        else:
-            shown = f"<dd>{text(value)}</dd>"
+        shown = value.html("dd") if isinstance(value, Num) else f"<dd>{text(value)}</dd>"
         lines.append(f"<dt>{text(label)}</dt>{shown}")
     return f'<dl id="{text(list_id)}">' + "\n".join(lines) + "</dl>"
 
