@@ -112,7 +112,7 @@ def test_overwrite_replaces_a_previous_result(data: Path, tmp_path) -> None:
     (run / "stray.txt").write_text("added by hand")
     assert identify(data / "log.npz", run, "--friction", "--overwrite") == 0
     assert sorted(p.name for p in run.iterdir()) == sorted(
-        [MARKER, "result.json", "run.yaml", "torques.png", "residuals.png"]
+        [MARKER, "result.json", "run.yaml", "torques.png", "residuals.png", "report.html"]
     )
     assert dynid.load_result(run).friction
     assert sorted(p.name for p in tmp_path.iterdir()) == ["data", "run"]  # no staging debris

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .run_config import RUN_FILE, run_yaml
+from .run_warnings import recorded_warnings
 
 
 def _steps(total: int) -> Callable[[str], None]:
@@ -159,6 +160,11 @@ def demo(args: argparse.Namespace) -> None:
 
 
 def identify(args: argparse.Namespace) -> None:
+    with recorded_warnings() as seen:  # for report.html; shown as they happen all the same
+        _identify(args, seen)
+
+
+def _identify(args: argparse.Namespace, seen: list[str]) -> None:
     from ..export.output_folder import check_output_path
     from ..export.result_files import save_result
     from ..identification.log_identification import identify_log
@@ -172,7 +178,7 @@ def identify(args: argparse.Namespace) -> None:
     if args.current:
         if len(args.log) != 1:
             raise ValueError("--current: one LOG (several logs are not supported with currents)")
-        identify_from_currents(args)
+        identify_from_currents(args, seen)
         return
     if any(getattr(args, k) is not None for k in ("payload_log", "payload", "payload_mass")):
         raise ValueError("--payload-log, --payload, --payload-mass: only with --current")
@@ -227,10 +233,14 @@ def identify(args: argparse.Namespace) -> None:
         inputs=identify_inputs(args),
         # The defaults worked out here, as the run used them: the method, the prior's weight.
         files={RUN_FILE: run_yaml(args, method=method, **_resolved_prior(result))},
+        report=args.report,
+        report_warnings=seen,
     )
     step(
         f"wrote {path}, {path.parent / RUN_FILE}, {path.parent / 'torques.png'}, "
-        f"{path.parent / 'residuals.png'}" + (" (and per log)" if len(logs) > 1 else "")
+        f"{path.parent / 'residuals.png'}"
+        + (" (and per log)" if len(logs) > 1 else "")
+        + _report_written(args, path)
     )
 
 
@@ -297,7 +307,7 @@ def load_robot(args: argparse.Namespace, source: Any) -> Any:
         raise
 
 
-def identify_from_currents(args: argparse.Namespace) -> None:
+def identify_from_currents(args: argparse.Namespace, seen: list[str] | None = None) -> None:
     """``dynid identify --current``: drive gains and base parameters from motor currents."""
     from ..export.result_files import save_result
     from ..identification.drive_gains import identify_drive_gains
@@ -353,11 +363,21 @@ def identify_from_currents(args: argparse.Namespace) -> None:
         overwrite=args.overwrite,
         inputs=identify_inputs(args),
         files={RUN_FILE: run_yaml(args, method=args.method or "nls")},
+        report=args.report,
+        report_warnings=seen or [],
     )
-    step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+    step(
+        f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}"
+        + _report_written(args, path)
+    )
 
 
 def validate(args: argparse.Namespace) -> None:
+    with recorded_warnings() as seen:  # for report.html; shown as they happen all the same
+        _validate(args, seen)
+
+
+def _validate(args: argparse.Namespace, seen: list[str]) -> None:
     from ..export.output_folder import check_output_path
     from ..export.result_files import load_result, save_validation
     from ..identification.log_identification import run_validation
@@ -411,8 +431,19 @@ def validate(args: argparse.Namespace) -> None:
         log_source=str(args.log),
         overwrite=args.overwrite,
         files={RUN_FILE: run_yaml(args)},
+        report=args.report,
+        result=result,
+        report_warnings=seen,
     )
-    step(f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}")
+    step(
+        f"wrote {path}, {path.parent / 'torques.png'}, {path.parent / 'residuals.png'}"
+        + _report_written(args, path)
+    )
+
+
+def _report_written(args: argparse.Namespace, path: Any) -> str:
+    """ ", FOLDER/report.html" when the command wrote it (not with --no-report)."""
+    return f", {path.parent / 'report.html'}" if args.report else ""
 
 
 def validation_preparation(result: Any, args: argparse.Namespace) -> tuple[dict[str, Any], str]:

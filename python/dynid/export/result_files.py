@@ -20,7 +20,7 @@ coefficients follows from them.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Union
 
@@ -72,6 +72,8 @@ def save_result(
     overwrite: bool = False,
     inputs: Iterable[PathLike | None] = (),
     files: Mapping[str, str] | None = None,
+    report: bool = False,
+    report_warnings: Sequence[str] = (),
 ) -> Path:
     """Write ``folder/result.json`` and, when ``plots``, ``torques.png`` and ``residuals.png`` of
     the fit on ``log`` (default: the training log, when the result kept it; of several training
@@ -79,7 +81,10 @@ def save_result(
     the JSON path. ``files`` are more text files to write into the folder (name: content, e.g.
     ``dynid identify``'s ``run.yaml``). ``folder`` must be new or empty unless ``overwrite``,
     and ``overwrite`` replaces only a folder dynid wrote that holds none of ``inputs`` nor the
-    logs' files; it is written as a whole or not at all (:mod:`dynid.export.output_folder`)."""
+    logs' files; it is written as a whole or not at all (:mod:`dynid.export.output_folder`).
+    With ``report``, ``report.html`` too (:func:`dynid.export.report.write_report`: the fit on
+    ``log`` or the training logs kept, the coefficients, ``report_warnings``), in the same
+    folder written whole."""
     given = log is not None
     log = log if log is not None else result.log
     more = result.logs[1:] if not given else ()
@@ -96,6 +101,10 @@ def save_result(
             save_plots(staging, log, predicted, "training log")
             for k, (other, part) in enumerate(zip(more, result.fitted_logs[1:]), start=2):
                 save_plots(staging, other, part, f"training log {k}", suffix=f"_{k}")
+        if report:
+            from .report import write_report  # matplotlib: imported when reporting
+
+            write_report(result, staging, log=log if given else None, warnings=report_warnings)
     return Path(folder) / RESULT_FILE
 
 
@@ -108,13 +117,18 @@ def save_validation(
     plots: bool = True,
     overwrite: bool = False,
     files: Mapping[str, str] | None = None,
+    report: bool = False,
+    result: LogIdentification | None = None,
+    report_warnings: Sequence[str] = (),
 ) -> Path:
     """Write ``folder/validation.json`` (per-joint metrics, preparation, sources) and, when
     ``plots``, the torque and residual plots of the validation log; returns the JSON path.
-    ``files`` are more text files to write into the folder (name: content).
+    ``files`` are more text files to write into the folder (name: content). With ``report``,
+    ``report.html`` too (:func:`dynid.export.report.write_report`; with ``result``, the result
+    applied, its coefficients and training errors; ``report_warnings`` listed).
     ``overwrite`` never replaces a folder that holds ``result_source`` or the log's file
     (:mod:`dynid.export.output_folder`)."""
-    report = {
+    record = {
         "format": VALIDATION_FORMAT,
         "version": VALIDATION_VERSION,
         "dynid_version": dynid_version(),
@@ -129,11 +143,21 @@ def save_validation(
     inputs = [result_source, log_source, validation.log.source]
     _check_file_names(files, VALIDATION_FILE)
     with output_folder(folder, overwrite, inputs=inputs) as staging:
-        (staging / VALIDATION_FILE).write_text(dumps_json(report) + "\n")
+        (staging / VALIDATION_FILE).write_text(dumps_json(record) + "\n")
         for name, text in (files or {}).items():
             (staging / name).write_text(text)
         if plots:
             save_plots(staging, validation.log, validation.predicted, "validation log")
+        if report:
+            from .report import write_report  # matplotlib: imported when reporting
+
+            write_report(
+                validation,
+                staging,
+                result=result,
+                warnings=report_warnings,
+                sources={"result": result_source, "log": log_source},
+            )
     return Path(folder) / VALIDATION_FILE
 
 
