@@ -159,8 +159,8 @@ def estimate_payload_from_logs(
         if rows is not None:
             w = np.where(rows, w, 0.0)
         e = tau - Y @ fit.theta
-        A += np.einsum("tjp,tj,tjq->pq", Y, w, Y)
-        gradients[r].append(np.einsum("tjp,tj->tp", Y, w * e))
+        A += np.tensordot(Y * w[..., None], Y, axes=([0, 1], [0, 1]))  # sum_t Y_t^T W Y_t
+        gradients[r].append(np.matmul((w * e)[:, None, :], Y)[:, 0, :])  # g_t = Y_t^T W e_t
         residuals[r].append(e * np.sqrt(w))
     segments = [np.concatenate(parts) for parts in residuals]
     width = bartlett_width(segments)

@@ -89,6 +89,10 @@ def long_run_covariance(
             continue
         cumulative = np.vstack([np.zeros(q), np.cumsum(h, axis=0)])
         batches = cumulative[L:] - cumulative[:-L]  # (T - L + 1, q) sums of L consecutive h_t
-        # T / (T - L + 1): the batches cover T - L + 1 starts of the T samples.
-        omega += batches.T @ batches / L * T / (T - L + 1)
+        # T / (T - L + 1): the batches cover T - L + 1 starts of the T samples; T / (T - L):
+        # the fitted residuals sum to zero on the regressor (the normal equations), which takes
+        # about L / T of the batches' variance away (Meketon & Schmeiser's overlapping batch
+        # means, Proc. Winter Simulation Conference 1984, have the same factor).
+        scale = T / (T - L + 1) * (T / (T - L) if T > L else 1.0)
+        omega += batches.T @ batches / L * scale
     return omega
