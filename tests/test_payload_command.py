@@ -85,7 +85,9 @@ def fourier_run(robot: dynid.Robot, seed: int, seconds: float = 20.0) -> tuple[n
     rng = np.random.default_rng(seed)
     n = robot.n
     trajectory = dynid.FourierTrajectory(
-        2 * np.pi * 0.1, 0.25 * rng.standard_normal((n, 5)), 0.25 * rng.standard_normal((n, 5)),
+        2 * np.pi * 0.1,
+        0.25 * rng.standard_normal((n, 5)),
+        0.25 * rng.standard_normal((n, 5)),
         np.zeros(n),
     )
     t = np.arange(0.0, seconds, 1.0 / FS)
@@ -165,7 +167,7 @@ def test_kuka_angles_at_the_gimbal_lock_rebuild_the_rotation():
     # B = 90 deg: A and C are not separate; C = 0 and A carries their difference (1e-12).
     R = rz(0.4) @ ry(np.pi / 2) @ rx(0.1)
     A, B, C = np.radians(kuka_angles(R))
-    assert C == 0.0 and B == pytest.approx(np.pi / 2, abs=1e-12)
+    assert C == 0.0 and pytest.approx(np.pi / 2, abs=1e-12) == B
     np.testing.assert_allclose(rz(A) @ ry(B) @ rx(C), R, rtol=0, atol=1e-12)
 
 
@@ -182,9 +184,14 @@ def test_franka_and_urscript_fields_hold_the_given_payload():
     assert match is not None, line
     assert float(match[1]) == MASS
     assert [float(v) for v in match[2].split(",")] == COM.tolist()
-    I = INERTIA
+    J = INERTIA
     assert [float(v) for v in match[3].split(",")] == [
-        I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]
+        J[0, 0],
+        J[1, 1],
+        J[2, 2],
+        J[0, 1],
+        J[0, 2],
+        J[1, 2],
     ]
 
 
@@ -280,7 +287,9 @@ def test_ur5_filtered_logs_the_std_are_calibrated_over_40_seeds():
         z.append(z_scores(est))
         p = est.fit.theta.size - 10
         white.append(
-            z_scores(_physical(est.fit.theta[p:], est.fit.covariance[p:, p:], robot, "flange", None))
+            z_scores(
+                _physical(est.fit.theta[p:], est.fit.covariance[p:, p:], robot, "flange", None)
+            )
         )
     rms = np.sqrt((np.array(z) ** 2).mean(axis=0))
     assert np.all((rms > 0.7) & (rms < 1.3)), rms
@@ -376,7 +385,7 @@ def test_the_command_writes_every_format_in_the_flange_frame(panda_logs, tmp_pat
     assert kuka.startswith("LOAD_DATA[1]={M ")
     model = load_model(out / "model.json")
     truth = dynid.models.panda().with_payload(MASS, COM, INERTIA)
-    t, q, qd, qdd = fourier_run(truth, 9, seconds=1.0)
+    _, q, qd, qdd = fourier_run(truth, 9, seconds=1.0)
     np.testing.assert_allclose(model.rnea(q, qd, qdd), truth.rnea(q, qd, qdd), atol=1e-9)
 
 
@@ -387,12 +396,37 @@ def test_the_command_with_a_result_uses_its_model_and_preparation(tmp_path, caps
     save_log(noisy_log(robot, 11, UR5_NOISE), tmp_path / "u.npz")
     save_log(noisy_log(robot.with_payload(MASS, COM, INERTIA), 12, UR5_NOISE), tmp_path / "l.npz")
     ident = tmp_path / "ident"
-    assert main(["identify", str(tmp_path / "u.npz"), "--model", "ur5", "--cutoff", "20",
-                 "--output", str(ident)]) == 0
+    assert (
+        main(
+            [
+                "identify",
+                str(tmp_path / "u.npz"),
+                "--model",
+                "ur5",
+                "--cutoff",
+                "20",
+                "--output",
+                str(ident),
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
     out = tmp_path / "p"
-    assert main(["payload", str(tmp_path / "u.npz"), str(tmp_path / "l.npz"),
-                 "--model", str(ident), "--output", str(out)]) == 0
+    assert (
+        main(
+            [
+                "payload",
+                str(tmp_path / "u.npz"),
+                str(tmp_path / "l.npz"),
+                "--model",
+                str(ident),
+                "--output",
+                str(out),
+            ]
+        )
+        == 0
+    )
     printed = capsys.readouterr().out
     assert "--cutoff 20.0 (recorded in the result)" in printed
     record = json.loads((out / "payload.json").read_text())
@@ -411,12 +445,24 @@ def test_the_command_with_a_result_uses_its_model_and_preparation(tmp_path, caps
 )
 def test_the_commands_errors_are_one_line(panda_logs, tmp_path, capsys, extra, message):
     if "{d}/ident" in extra:
-        argv = ["identify", str(panda_logs / "unloaded.npz"), "--model", "panda", "--output",
-                str(tmp_path / "ident")]
+        argv = [
+            "identify",
+            str(panda_logs / "unloaded.npz"),
+            "--model",
+            "panda",
+            "--output",
+            str(tmp_path / "ident"),
+        ]
         assert main(argv) == 0
         capsys.readouterr()
-    argv = ["payload", str(panda_logs / "unloaded.npz"), str(panda_logs / "loaded.npz"),
-            "--output", str(tmp_path / "out"), *[a.format(d=tmp_path) for a in extra]]
+    argv = [
+        "payload",
+        str(panda_logs / "unloaded.npz"),
+        str(panda_logs / "loaded.npz"),
+        "--output",
+        str(tmp_path / "out"),
+        *[a.format(d=tmp_path) for a in extra],
+    ]
     if "--loaded-unloaded" in extra:
         with pytest.raises(SystemExit) as info:
             main(argv)

@@ -482,6 +482,7 @@ def payload(args: argparse.Namespace) -> None:
     from ..export.output_folder import check_output_path, output_folder
     from ..export.payload_out import write_payload_files
     from ..export.result_files import load_model_or_result
+    from ..identification.log_identification import LogIdentification
     from ..identification.payload_logs import estimate_payload_from_logs
 
     inputs = [args.unloaded, args.loaded, args.model]
@@ -489,12 +490,14 @@ def payload(args: argparse.Namespace) -> None:
     check_links(args, args.model)
     step = _steps(3)
     model = load_model_or_result(args.model, **model_links(args, args.model))
-    result = not hasattr(model, "rnea")  # a result of identify, not a robot
-    robot = model.robot if result else model
+    result = isinstance(model, LogIdentification)
+    robot = model.robot if isinstance(model, LogIdentification) else model
     if result and (args.rotor or args.friction or args.offset):
-        raise ValueError("--rotor, --friction, --offset: only with a MODEL; a result brings its own")
+        raise ValueError(
+            "--rotor, --friction, --offset: only with a MODEL; a result brings its own"
+        )
     logs = [load_log_of(args, robot.joint_names, path) for path in (args.unloaded, args.loaded)]
-    if result:
+    if isinstance(model, LogIdentification):
         options, sources = validation_preparation(model, args)
     else:
         options = preparation_options(args)
@@ -514,6 +517,7 @@ def payload(args: argparse.Namespace) -> None:
         method=args.method,
         frame="tool",
     )
+    assert estimate.fit is not None  # the joint least-squares fit
     step(
         f"fitted the unloaded model and the payload together ({estimate.fit.theta.size} "
         f"coefficients); noise correlation over {estimate.bartlett_width} sample(s)"

@@ -79,8 +79,8 @@ def franka_endeffector(estimate: PayloadEstimate) -> dict[str, Any]:
 def urscript(estimate: PayloadEstimate) -> str:
     """The URScript line ``set_target_payload(m, [cx, cy, cz], [Ixx, Iyy, Izz, Ixy, Ixz,
     Iyz])``: kg, m, kg m^2 (the floats written in full, as Python's repr)."""
-    mass, com, I = controller_payload(estimate)
-    inertia = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+    mass, com, J = controller_payload(estimate)
+    inertia = [J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]]
     return (
         f"set_target_payload({_number(mass)}, [{', '.join(map(_number, com))}], "
         f"[{', '.join(map(_number, inertia))}])"

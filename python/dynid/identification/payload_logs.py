@@ -21,7 +21,6 @@ filtered log are not independent draws.
 from __future__ import annotations
 
 import dataclasses
-
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, Union

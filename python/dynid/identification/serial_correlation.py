@@ -62,7 +62,7 @@ def correlation_window(residuals: Sequence[NDArray[np.float64]]) -> int:
     rho = autocorrelation(residuals, limit)
     tau = 1.0 + 2.0 * np.cumsum(rho[1:])
     for M in range(1, limit + 1):
-        if M >= SOKAL_C * tau[M - 1]:
+        if SOKAL_C * tau[M - 1] <= M:
             return M
     return limit
 
