@@ -10,8 +10,8 @@ parameters and, as identified, rotor, friction, offsets, ...). Both logs are fit
 
 so that the unloaded model's own estimation error is in the payload's covariance. Taking theta
 from an earlier identification instead and treating its prediction as exact (``estimate_payload(
-..., tau_unloaded=result.predict(log))``) leaves that error out: on a simulated UR5 the inertia
-then came out 2-3 std off even on unfiltered data (docs/payload.md).
+..., tau_unloaded=result.predict(log))``) leaves that error out: on a simulated UR5 the z-scores
+of the payload had an RMS of 1.5-2 instead of 1 even on unfiltered data (docs/payload.md).
 
 The standard deviations then follow the residuals' correlation in time
 (:mod:`dynid.identification.serial_correlation`): both logs are usually low-passed, and rows of a
