@@ -526,3 +526,76 @@ def info(args: argparse.Namespace) -> None:
 def _joint_names(model: Any) -> Any:
     """The joint names of a model or a result's model (``load_model_or_result``)."""
     return getattr(model, "robot", model).joint_names
+
+
+def payload(args: argparse.Namespace) -> None:
+    """``dynid payload UNLOADED LOADED --model RESULT|MODEL``: the payload, fitted with the
+    unloaded arm's torque model on both logs, written for the controllers (docs/payload.md)."""
+    from ..export.output_folder import check_output_path, output_folder
+    from ..export.payload_out import write_payload_files
+    from ..export.result_files import load_model_or_result
+    from ..identification.log_identification import LogIdentification
+    from ..identification.payload_logs import estimate_payload_from_logs
+
+    inputs = [args.unloaded, args.loaded, args.model]
+    check_output_path(args.output, args.overwrite, inputs=inputs)
+    check_links(args, args.model)
+    step = _steps(3)
+    model = load_model_or_result(args.model, **model_links(args, args.model))
+    result = isinstance(model, LogIdentification)
+    robot = model.robot if isinstance(model, LogIdentification) else model
+    if result and (args.rotor or args.friction or args.offset):
+        raise ValueError(
+            "--rotor, --friction, --offset: only with a MODEL; a result brings its own"
+        )
+    logs = [load_log_of(args, robot.joint_names, path) for path in (args.unloaded, args.loaded)]
+    if isinstance(model, LogIdentification):
+        options, sources = validation_preparation(model, args)
+    else:
+        options = preparation_options(args)
+        sources = ", ".join(f"{k}={v}" for k, v in options.items()) or "none"
+    step(
+        f"logs {args.unloaded} ({logs[0].T} samples), {args.loaded} ({logs[1].T} samples, "
+        f"loaded); model {args.model}: {robot.name}, {robot.n} joints; preparation: {sources}"
+    )
+    estimate = estimate_payload_from_logs(
+        logs[0],
+        logs[1],
+        model,
+        rotor=args.rotor,
+        friction=args.friction,
+        offset=args.offset,
+        preparation=options,
+        method=args.method,
+        frame="tool",
+    )
+    assert estimate.fit is not None  # the joint least-squares fit
+    step(
+        f"fitted the unloaded model and the payload together ({estimate.fit.theta.size} "
+        f"coefficients); noise correlation over {estimate.bartlett_width} sample(s)"
+    )
+    print(payload_summary(estimate), flush=True)
+    with output_folder(args.output, args.overwrite, inputs=inputs) as staging:
+        written, skipped = write_payload_files(estimate, robot, staging)
+    for reason in skipped:
+        print(f"note: not written: {reason}", flush=True)
+    step(f"wrote {', '.join(f'{args.output}/{name}' for name in written)}")
+
+
+def payload_summary(estimate: Any) -> str:
+    """The payload with its standard deviations, in the estimate's frame."""
+    lines = [f"payload in the {estimate.frame} frame (value +- std):"]
+    lines.append(f"  mass       {estimate.mass:12.6g} +- {estimate.mass_std:.3g} kg")
+    if estimate.com is None:
+        lines.append("  (mass not significant: no centre of mass or inertia)")
+        return "\n".join(lines)
+    for axis, value, std in zip("xyz", estimate.com, estimate.com_std):
+        lines.append(f"  com {axis}      {1000 * value:12.6g} +- {1000 * std:.3g} mm")
+    if estimate.inertia is not None:
+        for i, j in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
+            name = "I" + "xyz"[i] + "xyz"[j]
+            lines.append(
+                f"  {name:<10} {estimate.inertia[i, j]:12.6g} +- "
+                f"{estimate.inertia_std[i, j]:.3g} kg m^2 (about the com)"
+            )
+    return "\n".join(lines)

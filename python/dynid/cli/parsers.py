@@ -30,6 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_info(subcommands)
     _add_export(subcommands)
     _add_residual(subcommands)
+    _add_payload(subcommands)
     # Each command knows its own parser, so that an option it does not have is reported with the
     # command's usage, not the top level's (main()).
     for command in subcommands.choices.values():
@@ -216,6 +217,47 @@ def _add_residual(subcommands: Any) -> None:
     _add_links(p)
     _add_output(p, "dynid-residual")
     p.set_defaults(run=commands.residual)
+
+
+def _add_payload(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "payload",
+        help="estimate a payload from logs without and with it; write it for the controllers",
+        description="Estimate the mass, centre of mass and inertia of a payload on the last link "
+        "(with standard deviations) from a log of the arm without it (UNLOADED) and one with it "
+        "(LOADED), fitted together with the unloaded arm's torque model; write payload.json, "
+        "franka_endeffector.json, urscript.txt, kuka_load_data.txt and model.json (the model "
+        "with the payload) in the model's tool frame (docs/payload.md).",
+    )
+    p.add_argument("unloaded", metavar="UNLOADED", help="log of the arm without the payload")
+    p.add_argument("loaded", metavar="LOADED", help="log of the arm carrying the payload")
+    p.add_argument(
+        "--model",
+        required=True,
+        metavar="RESULT|MODEL",
+        help="the unloaded arm: a result of `dynid identify` (its torque model and recorded "
+        "preparation), a built-in model, a model file or a URDF",
+    )
+    p.add_argument(
+        "--rotor", action="store_true", help="with a MODEL: the rotor inertia columns Ia"
+    )
+    p.add_argument(
+        "--friction", action="store_true", help="with a MODEL: viscous and Coulomb friction"
+    )
+    p.add_argument(
+        "--offset", action="store_true", help="with a MODEL: a constant torque per joint"
+    )
+    p.add_argument(
+        "--method",
+        choices=("ols", "wls"),
+        default="wls",
+        help="ordinary or weighted (per-joint noise) least squares (default wls)",
+    )
+    _add_links(p)
+    _add_preparation(p)
+    _add_output(p, "dynid-payload")
+    # A result's recorded preparation applies, each option given replacing it (as validate).
+    p.set_defaults(run=commands.payload, recorded_preparation=True)
 
 
 def _add_current(p: argparse.ArgumentParser) -> None:

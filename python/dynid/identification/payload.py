@@ -89,6 +89,10 @@ class PayloadEstimate(ValueEquality):
     #: the least-squares fit of pi_L (residuals, condition number, ...); None from
     #: :func:`payload_from_identified`, which solves for pi_L from coefficient changes
     fit: LeastSquaresResult | None
+    #: the width (samples) of the Bartlett kernel behind the standard deviations
+    #: (:mod:`dynid.identification.serial_correlation`); 1: the rows taken as independent, as
+    #: :func:`estimate_payload` and :func:`payload_from_identified` do
+    bartlett_width: int = 1
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready values (floats, nested lists, None): mass, com, inertia with their std,
@@ -107,6 +111,7 @@ class PayloadEstimate(ValueEquality):
             "parameters": dict(zip(PAYLOAD_NAMES, self.parameters.tolist())),
             "parameters_std": dict(zip(PAYLOAD_NAMES, self.parameters_std.tolist())),
             "frame": self.frame,
+            "bartlett_width": self.bartlett_width,
         }
 
 

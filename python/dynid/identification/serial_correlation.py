@@ -1,0 +1,98 @@
+"""Standard deviations of a least-squares estimate when the residuals are correlated in time.
+
+The covariance sigma^2 (Y^T W Y)^-1 of :func:`dynid.least_squares` treats every row as an
+independent draw. A log low-passed before the fit (``dynid.prepare_log(cutoff=...)``, or a robot
+that filters its torque signal itself) breaks that: the noise of neighbouring samples is nearly
+the same, a log of T samples holds about T / tau_int independent ones, and the white-noise
+standard deviations come out too small by about sqrt(tau_int), the integrated autocorrelation
+time of the noise (in samples). On a simulated UR5 with a payload, low-passed at 10 Hz at
+500 Hz (tau_int ~ 30), the payload's inertia came out 4.5-7 of these standard deviations off
+(docs/payload.md, "Why the inertia was 5 standard deviations off").
+
+The estimate is theta_hat - theta = A^-1 sum_t g_t, with A = sum_t Y_t^T W Y_t and
+g_t = Y_t^T W e_t the sample's weighted residual on its regressor rows (all joints of sample t).
+Its covariance is A^-1 Omega A^-1 with Omega = sum over lags l of sum_t g_t g_{t+l}^T, the
+long-run covariance of g (the "sandwich"; white rows: Omega = A). Omega is estimated with the
+Bartlett kernel of width L (Newey & West, Econometrica 55(3), 1987), computed as overlapping
+batch means: Omega ~ 1/L sum_t (g_t + ... + g_{t+L-1}) (...)^T, positive semi-definite by
+construction. L comes from the residuals themselves: twice Sokal's automatic window M for the
+integrated autocorrelation time (the smallest M with M >= C tau_int(M), C = 5; A. D. Sokal,
+"Monte Carlo methods in statistical mechanics", 1996, sect. 3), pooled over the joints. So no
+filter needs to be known: the correlation the data show is the one accounted for.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: Sokal's constant: the window M is the first with M >= SOKAL_C tau_int(M).
+SOKAL_C = 5.0
+#: The Bartlett width as a multiple of Sokal's window (lags up to M keep half their weight or
+#: more). Measured on the UR5 (docs/payload.md): C = 3, 5, 8 gave the same z-scores.
+WIDTH_PER_WINDOW = 2
+#: At most this fraction of the shortest segment (the kernel's bias grows with L / T).
+MAX_WIDTH_FRACTION = 0.1
+
+
+def autocorrelation(residuals: Sequence[NDArray[np.float64]], lags: int) -> NDArray[np.float64]:
+    """(lags + 1,) the autocorrelation of the (T_k, n) residual segments (weighted by the
+    joints' noise, so that every joint counts alike), pooled over joints and segments; rho[0] =
+    1. Lags never cross from one segment into the next."""
+    total = np.zeros(lags + 1)
+    for segment in residuals:
+        T = segment.shape[0]
+        spectrum = np.fft.rfft(segment, n=2 * T, axis=0)  # zero-padded: no wrap-around
+        auto = np.fft.irfft(np.abs(spectrum) ** 2, n=2 * T, axis=0)
+        total[: min(lags + 1, T)] += auto[: min(lags + 1, T)].sum(axis=1)
+    if total[0] <= 0.0:  # no residual at all (noise-free data): nothing correlates
+        rho = np.zeros(lags + 1)
+        rho[0] = 1.0
+        return rho
+    return total / total[0]
+
+
+def correlation_window(residuals: Sequence[NDArray[np.float64]]) -> int:
+    """Sokal's window M for the residual segments: the first M with M >= SOKAL_C tau_int(M),
+    tau_int(M) = 1 + 2 sum_{l=1}^{M} rho_l (at least 1; capped by the segments' length)."""
+    shortest = min(segment.shape[0] for segment in residuals)
+    limit = max(1, int(MAX_WIDTH_FRACTION * shortest) // WIDTH_PER_WINDOW)
+    rho = autocorrelation(residuals, limit)
+    tau = 1.0 + 2.0 * np.cumsum(rho[1:])
+    for M in range(1, limit + 1):
+        if SOKAL_C * tau[M - 1] <= M:
+            return M
+    return limit
+
+
+def bartlett_width(residuals: Sequence[NDArray[np.float64]]) -> int:
+    """The Bartlett kernel's width L for :func:`long_run_covariance`: WIDTH_PER_WINDOW times
+    :func:`correlation_window`."""
+    return WIDTH_PER_WINDOW * correlation_window(residuals)
+
+
+def long_run_covariance(
+    influence: Sequence[NDArray[np.float64]], width: int
+) -> NDArray[np.float64]:
+    """(q, q) the Bartlett-kernel estimate of Var(sum_t h_t) from the (T_k, q) segments of
+    h_t (e.g. rows of A^-1 times g_t): overlapping batch means of ``width`` samples, each segment
+    on its own, summed. ``width`` 1 is the white-noise sum of h_t h_t^T."""
+    q = influence[0].shape[1]
+    omega = np.zeros((q, q))
+    for h in influence:
+        T = h.shape[0]
+        L = max(1, min(int(width), T))
+        if L == 1:
+            omega += h.T @ h
+            continue
+        cumulative = np.vstack([np.zeros(q), np.cumsum(h, axis=0)])
+        batches = cumulative[L:] - cumulative[:-L]  # (T - L + 1, q) sums of L consecutive h_t
+        # T / (T - L + 1): the batches cover T - L + 1 starts of the T samples; T / (T - L):
+        # the fitted residuals sum to zero on the regressor (the normal equations), which takes
+        # about L / T of the batches' variance away (Meketon & Schmeiser's overlapping batch
+        # means, Proc. Winter Simulation Conference 1984, have the same factor).
+        scale = T / (T - L + 1) * (T / (T - L) if T > L else 1.0)
+        omega += batches.T @ batches / L * scale
+    return omega
