@@ -48,6 +48,7 @@ if TYPE_CHECKING:
     from .identification.identify import LeastSquaresResult, RankDeficientError, least_squares
     from .identification.log_identification import LogIdentification, identify_log, validate_log
     from .identification.payload import PayloadEstimate, estimate_payload, payload_from_identified
+    from .identification.payload_logs import estimate_payload_from_logs
     from .identification.physical import PhysicalResult, physical_least_squares
     from .identification.recursive import RecursiveLeastSquares
     from .identification.streaming import LeastSquaresAccumulator, least_squares_streaming
@@ -114,6 +115,7 @@ _LAZY = {
     "dynamic_bounds": ".model.bounds",
     "PayloadEstimate": ".identification.payload",
     "estimate_payload": ".identification.payload",
+    "estimate_payload_from_logs": ".identification.payload_logs",
     "payload_from_identified": ".identification.payload",
     "scale_time": ".motion.time_scaling",
     "scale_motion": ".motion.time_scaling",
@@ -149,6 +151,7 @@ __all__ = [
     "dynamic_bounds",
     "elastic",
     "estimate_payload",
+    "estimate_payload_from_logs",
     "excitation",
     "get_cmake_dir",
     "get_include",
