@@ -11,7 +11,7 @@ theta solves sum_i psi(u_i) Y_i^T / s_j = 0 with
     Tukey:  psi(u) = u (1 - (u/c)^2)^2 for |u| <= c, 0    c = 4.685 (95 % efficiency)
 
 solved by weighted least squares with w_i = psi(u_i) / u_i, re-weighting and re-scaling until
-the fitted torques change by less than 1e-10 of their norm. Huber's loss is convex: it starts
+the fitted torques change by less than 1e-13 of their norm. Huber's loss is convex: it starts
 from the WLS fit. Tukey's redescends (an outlier beyond c gets weight 0) and has local minima:
 it starts from the converged Huber fit, the usual start of a redescending M-estimator.
 
@@ -38,7 +38,7 @@ TUNING = {"huber": 1.345, "tukey": 4.685}
 MAD_FACTOR = 1.482602218505602
 MAX_ITERATIONS = 200
 #: Converged when the fitted torques change by less than this fraction of their norm.
-TOLERANCE = 1e-10
+TOLERANCE = 1e-13
 
 Psi = Callable[[NDArray[np.float64], float], NDArray[np.float64]]
 

@@ -98,6 +98,7 @@ def tls(problem: Problem) -> EstimatorFit:
     )  # fmt: skip
     report = {
         "acceleration_noise": [float(x) for x in sigma_a],
+        "equation_noise": [float(np.sqrt(x)) for x in variance],  # 1 / the rows' weights
         "torque_noise": [float(np.sqrt(x)) for x in torque_noise],
         "propagated_noise": [float(np.sqrt(x)) for x in propagated],
         "noise_share": float(share),
@@ -105,10 +106,12 @@ def tls(problem: Problem) -> EstimatorFit:
         "converged": converged,
     }
     notes = []
-    if np.any(propagated > variance):
+    # Beyond the residual variance's sampling error: the noise given explains more than all.
+    too_large = propagated > variance * (1.0 + 3.0 * np.sqrt(2.0 / np.maximum(counts, 1.0)))
+    if np.any(too_large):
         notes.append(
             "tls: the accelerations' noise explains more than the whole residual on joint(s) "
-            + ", ".join(str(j + 1) for j, x in zip(rows.joints, propagated > variance) if x)
+            + ", ".join(str(j + 1) for j, x in zip(rows.joints, too_large) if x)
             + ": acceleration_noise is probably too large"
         )
     return EstimatorFit(result, None, report, tuple(notes))
