@@ -114,8 +114,9 @@ def test_irls_equals_an_independent_irls(loss):
 
 def test_irls_ignores_outliers_and_reversal_spikes():
     """One 20 s log. WLS: Fs off by ~10 std (the reversal bursts), Fv by ~-8. Tukey: every
-    coefficient within 3 std of the truth, and within 1 std (measured 0.77) of its own estimate
-    on the same log without the spikes (it fits ~5 % fewer rows); it rejects (weight 0) the spikes beyond 4.685 robust sigma."""
+    coefficient within 3 std of the truth, and within 1 std (measured 0.77) of its own
+    estimate on the same log without the spikes (it fits ~5 % fewer rows); it rejects
+    (weight 0) the spikes beyond 4.685 robust sigma."""
     dirty, clean = spiky(7, 20.0), spiky(7, 20.0, spikes=False, reversals=False)
     wls = _fit(dirty, "wls")
     assert np.abs(_z(wls)).max() > 6
@@ -139,7 +140,9 @@ def test_irls_standard_deviations_are_calibrated(loss, reversals):
     huber, 1.05 tukey on one-sided spikes; 1.05 tukey with reversal bursts too). Huber is not
     listed with the reversal bursts: their torque has the sign of the friction column, and
     Huber's bounded influence leaves a bias there (z RMS 1.5, mean z of Fs 1.8)."""
-    z = np.array([_z(_fit(spiky(seed, reversals=reversals), "irls", loss=loss)) for seed in range(20)])
+    z = np.array(
+        [_z(_fit(spiky(seed, reversals=reversals), "irls", loss=loss)) for seed in range(20)]
+    )
     rms = np.sqrt(np.mean(z**2))
     assert 0.7 <= rms <= 1.3, (rms, z.mean(axis=0))
     assert np.abs(z.mean(axis=0)).max() < 1.0  # no coefficient biased by 1 std (se 0.22)
@@ -169,8 +172,8 @@ ACCELERATION_NOISE = 0.2  # rad/s^2: positions with sigma_q = 0.2 dt^2 / sqrt(6)
 
 
 def noisy_states(seed: int, seconds: float = 20.0, torque_noise: float = 0.02) -> Log:
-    """Exact torques (plus ``torque_noise``, N m) of the true motion; q with white noise e, qd and qdd
-    its central differences: qdd + (e[t+1] - 2 e[t] + e[t-1]) / dt^2, the noise of
+    """Exact torques (plus ``torque_noise``, N m) of the true motion; q with white noise e, qd
+    and qdd its central differences: qdd + (e[t+1] - 2 e[t] + e[t-1]) / dt^2, the noise of
     accelerations differentiated twice from positions (std sqrt(6) sigma_q / dt^2)."""
     log = fourier_log(ARM, seed, seconds=seconds, fs=FS)
     rng = np.random.default_rng(100 + seed)
@@ -277,10 +280,11 @@ def weak_joint_2(seed: int) -> Log:
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_essential_parameters_remove_the_poorly_excited(seed):
-    """Removed: Fv2 (relative std 216 % and 35 % in the full fits of the two seeds) and the coefficients whose true value
-    is 0 (my1, my2 and the offsets, relative std 40-250 %); kept: the rest, each with a relative
-    std (by numpy's weighted lstsq on the kept columns) below the 10 % threshold; the held-out
-    RMS error on another seed's log grows by less than 1 % on each joint."""
+    """Removed: Fv2 (relative std 216 % and 35 % in the full fits of the two seeds) and the
+    coefficients whose true value is 0 (my1, my2 and the offsets, relative std 40-250 %);
+    kept: the rest, each with a relative std (by numpy's weighted lstsq on the kept columns)
+    below the 10 % threshold; the held-out RMS error on another seed's log grows by less than
+    1 % on each joint."""
     train, held_out = weak_joint_2(seed), weak_joint_2(seed + 100)
     full = _fit(train, "wls")
     got = _fit(train, "essential")
@@ -328,7 +332,10 @@ def test_cli_flags(tmp_path, capsys):
     argv = ["identify", str(tmp_path / "spiky.npz"), *model, "--method", "irls"]
     assert main([*argv, "--loss", "tukey", "--tuning", "4", "--output", str(out)]) == 0
     result = load_result(out)
-    assert result.method == "irls" and result.estimator["options"] == {"loss": "tukey", "tuning": 4.0}
+    assert result.method == "irls" and result.estimator["options"] == {
+        "loss": "tukey",
+        "tuning": 4.0,
+    }
     expected = _fit(spiky(2), "irls", loss="tukey", tuning=4.0)
     np.testing.assert_allclose(result.theta, expected.theta, rtol=1e-12)
     noisy = ["identify", str(tmp_path / "noisy.npz"), *model, "--method", "tls"]

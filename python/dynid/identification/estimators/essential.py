@@ -80,7 +80,7 @@ def essential(problem: Problem) -> EstimatorFit:
         "residual_growth": float(growth),
         "stopped": stopped,
     }
-    notes = ()
+    notes: tuple[str, ...] = ()
     if removed:
         notes = (
             f"essential parameters: {len(removed)} of {problem.p} coefficients removed "
@@ -109,9 +109,7 @@ def _fit(
     )
 
 
-def _weighted_rms(
-    rows: Rows, columns: list[int], theta: np.ndarray, sigma: np.ndarray
-) -> float:
+def _weighted_rms(rows: Rows, columns: list[int], theta: np.ndarray, sigma: np.ndarray) -> float:
     """RMS of the residuals divided by the joints' noise levels ``sigma``."""
     r = (rows.b - rows.A[:, columns] @ theta) / sigma[rows.joint]
     return float(np.sqrt(np.mean(r**2)))

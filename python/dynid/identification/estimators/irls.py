@@ -28,8 +28,15 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ._rows import Rows, block_sums, estimate, positive_number, sandwich, stacked_rows
-from ._rows import weighted_solve
+from ._rows import (
+    Rows,
+    block_sums,
+    estimate,
+    positive_number,
+    sandwich,
+    stacked_rows,
+    weighted_solve,
+)
 from .base import EstimatorFit, Problem
 
 #: Tuning constants of 95 % efficiency at Gaussian noise (Holland & Welsch 1977).
