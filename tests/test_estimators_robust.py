@@ -74,16 +74,18 @@ def _z(result: dynid.LogIdentification) -> np.ndarray:
 
 
 def _numpy_irls(A, b, group, loss, c, iterations=300):
-    """IRLS written independently: MAD scale per group, weights psi(u)/u, numpy lstsq."""
+    """IRLS written independently: MAD scale per group (Tukey: fixed at the Huber fit's),
+    weights psi(u)/u, numpy lstsq."""
     theta = np.linalg.lstsq(A, b, rcond=None)[0]
     stages = [("huber", 1.345), (loss, c)] if loss == "tukey" else [("huber", c)]
     for name, k in stages:
         for _ in range(iterations):
             r = b - A @ theta
-            s = np.zeros(r.size)
-            for g in np.unique(group):
-                x = r[group == g]
-                s[group == g] = 1.482602218505602 * np.median(np.abs(x - np.median(x)))
+            if name == "huber":
+                s = np.zeros(r.size)
+                for g in np.unique(group):
+                    x = r[group == g]
+                    s[group == g] = 1.482602218505602 * np.median(np.abs(x - np.median(x)))
             u = np.abs(r / s)
             if name == "huber":
                 w = np.minimum(1.0, k / np.maximum(u, 1e-300))

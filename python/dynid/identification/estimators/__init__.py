@@ -6,21 +6,19 @@ Each is a function ``(Problem) -> EstimatorFit`` (:mod:`.base`) in a file of its
 
 from __future__ import annotations
 
+from . import essential, irls, tls
 from .base import EstimatorFit, Problem
-from .essential import essential
-from .irls import irls
 from .registry import methods, register
-from .tls import tls
 
 register(
     "irls",
-    irls,
+    irls.irls,
     "robust M-estimator by iteratively reweighted least squares (outliers, reversal spikes)",
     ("loss", "tuning"),
 )
 register(
     "tls",
-    tls,
+    tls.tls,
     "errors in variables: total least squares with the accelerations' noise (noisy regressor)",
     ("acceleration_noise",),
     no_physical="the physical fit minimises a weighted residual, the attenuated objective "
@@ -28,7 +26,7 @@ register(
 )
 register(
     "essential",
-    essential,
+    essential.essential,
     "essential parameters: WLS without the coefficients the data determine poorly",
     ("essential_threshold",),
     no_physical="the physical fit estimates the standard parameters and cannot set base "
