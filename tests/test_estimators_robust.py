@@ -323,6 +323,25 @@ def test_essential_threshold_option():
     assert all(r["relative_std"] > 300.0 for r in got.estimator["removed"])
 
 
+# --------------------------------------------------------------------------- all three
+
+
+@pytest.mark.parametrize(
+    ("method", "options"),
+    [("irls", {"loss": "huber"}), ("irls", {"loss": "tukey"}), ("essential", {})],
+)
+def test_exact_logs_with_rows_left_out_give_the_truth(method, options):
+    """Two exact logs fitted together, the rows of slow joints left out (min_velocity): the
+    true base parameters to 1e-9 (a removed coefficient is one whose true value is 0)."""
+    logs = [fourier_log(ARM, 11, seconds=6.0), fourier_log(ARM, 12, seconds=6.0)]
+    got = identify_log(
+        logs, ARM, friction=True, offset=True, method=method, estimator_options=options,
+        preparation={"min_velocity": 0.05},
+    )  # fmt: skip
+    np.testing.assert_allclose(got.theta, TRUTH, rtol=0, atol=1e-9)
+    assert got.estimator["method"] == method
+
+
 # --------------------------------------------------------------------------- command line
 
 

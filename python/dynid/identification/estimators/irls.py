@@ -26,7 +26,8 @@ physically consistent fit of the same method, whose per-joint weights are 1 / s_
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -123,14 +124,14 @@ def irls(problem: Problem) -> EstimatorFit:
     return EstimatorFit(result, row_weights, report, tuple(notes))
 
 
-def _options(options: object) -> tuple[str, float]:
-    opts = dict(options)  # type: ignore[call-overload]
-    loss = opts.get("loss", "huber")
+def _options(options: Mapping[str, Any]) -> tuple[str, float]:
+    """``loss`` and ``tuning`` checked, the default tuning constant of the loss filled in."""
+    loss = options.get("loss")
     if loss is None:
         loss = "huber"
     if loss not in LOSSES:
         raise ValueError(f"loss: expected 'huber' or 'tukey', got {loss!r}")
-    tuning = opts.get("tuning")
+    tuning = options.get("tuning")
     c = TUNING[loss] if tuning is None else positive_number(tuning, "tuning")
     return str(loss), c
 

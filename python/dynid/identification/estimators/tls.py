@@ -68,7 +68,8 @@ def tls(problem: Problem) -> EstimatorFit:
     rows = stacked_rows(problem)
     index = np.full(problem.tau.shape, -1, dtype=np.int64)
     index[rows.sample, np.array(rows.joints)[rows.joint]] = np.arange(rows.N)
-    K = _noise_gram(problem, rows, index, sigma_a)  # (joints, p, p): sum_i C_i per joint
+    q = np.concatenate([run.q for run in problem.runs])  # the stacked samples' positions
+    K = _noise_gram(problem, q, rows, index, sigma_a)  # (joints, p, p): sum_i C_i per joint
     variance = np.asarray(problem.start.noise_variance, dtype=float)
     iterations, converged = 0, False
     for iterations in range(1, MAX_ITERATIONS + 1):  # noqa: B007 (reported)
@@ -84,7 +85,7 @@ def tls(problem: Problem) -> EstimatorFit:
     w = 1.0 / np.sqrt(_floored(variance))
     theta, share, H, R = _corrected(rows, K, w)
     r = rows.b - rows.A @ theta
-    Ctheta = _noise_times(problem, rows, index, sigma_a, theta)  # C_i theta per row
+    Ctheta = _noise_times(problem, q, rows, index, sigma_a, theta)  # C_i theta per row
     wi2 = (w**2)[rows.joint]
     scores = wi2[:, None] * (rows.A * r[:, None] + Ctheta)
     covariance = sandwich(H, block_sums(rows, scores), rows.N, problem.p)
@@ -146,10 +147,9 @@ def _floored(variance: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.maximum(variance, VARIANCE_FLOOR * largest)
 
 
-def _acceleration_part(problem: Problem, samples: slice) -> NDArray[np.float64]:
-    """(c, n, m, p): g_m = Y(q, 0, e_m) - Y(q, 0, 0) at the samples, the regressor's
-    derivative by the acceleration of joint m (the regressor is linear in qdd)."""
-    q = np.concatenate([run.q for run in problem.runs])[samples]
+def _acceleration_part(problem: Problem, q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(c, n, m, p): g_m = Y(q, 0, e_m) - Y(q, 0, 0) at the positions q (c, n), the
+    regressor's derivative by the acceleration of joint m (the regressor is linear in qdd)."""
     zero = np.zeros_like(q)
     static = problem.model.regressor(q, zero, zero)
     parts = []
@@ -166,12 +166,16 @@ def _chunks(problem: Problem) -> list[slice]:
 
 
 def _noise_gram(
-    problem: Problem, rows: Rows, index: NDArray[np.int64], sigma_a: NDArray[np.float64]
+    problem: Problem,
+    q: NDArray[np.float64],
+    rows: Rows,
+    index: NDArray[np.int64],
+    sigma_a: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """K_j = sum over joint j's rows of C_i = sum_m sigma_m^2 g_im g_im^T, (joints, p, p)."""
     K = np.zeros((len(rows.joints), problem.p, problem.p))
     for samples in _chunks(problem):
-        g = _acceleration_part(problem, samples) * sigma_a[None, None, :, None]
+        g = _acceleration_part(problem, q[samples]) * sigma_a[None, None, :, None]
         for k, j in enumerate(rows.joints):
             t = index[samples, j] >= 0
             gj = g[t, j].reshape(-1, problem.p)  # every (sample, m) pair of joint j's rows
@@ -181,6 +185,7 @@ def _noise_gram(
 
 def _noise_times(
     problem: Problem,
+    q: NDArray[np.float64],
     rows: Rows,
     index: NDArray[np.int64],
     sigma_a: NDArray[np.float64],
@@ -189,7 +194,7 @@ def _noise_times(
     """(N, p): C_i theta = sum_m sigma_m^2 g_im (g_im^T theta) for every row."""
     out = np.zeros((rows.N, problem.p))
     for samples in _chunks(problem):
-        g = _acceleration_part(problem, samples)
+        g = _acceleration_part(problem, q[samples])
         gt = g @ theta  # (c, n, m)
         Cth = np.einsum("tjmp,tjm,m->tjp", g, gt, sigma_a**2)
         at = index[samples]
