@@ -105,6 +105,7 @@ def _add_identify(subcommands: Any) -> None:
         metavar="W",
         help="with --prior: its weight (default 1e-5, docs/identification.md)",
     )
+    _add_robust_estimators(p)
     _add_current(p)
     _add_preparation(p)
     _add_motor_side(p)
@@ -407,6 +408,38 @@ def _add_motor_side(p: argparse.ArgumentParser) -> None:
         "model's gear_ratios, transmission and joint_offsets, q = R^-1 theta - joint_offsets, "
         "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md); validate applies it by itself "
         "to a result trained on a motor-side log, --no-motor-side reads LOG as joint side",
+    )
+
+
+def _add_robust_estimators(p: argparse.ArgumentParser) -> None:
+    """The options of --method irls, tls and essential (dynid.identification.estimators; each
+    flag is the estimator option of the same name)."""
+    p.add_argument(
+        "--loss",
+        choices=("huber", "tukey"),
+        help="--method irls: the robust loss (default huber; tukey rejects gross outliers "
+        "outright)",
+    )
+    p.add_argument(
+        "--tuning",
+        type=float,
+        metavar="C",
+        help="--method irls: the loss's tuning constant in robust standard deviations of each "
+        "joint's residuals (default 1.345 for huber, 4.685 for tukey)",
+    )
+    p.add_argument(
+        "--acceleration-noise",
+        type=float,
+        metavar="SIGMA",
+        help="--method tls (required): standard deviation of the noise of the prepared "
+        "accelerations, rad/s^2 (docs/identification.md, 'TLS')",
+    )
+    p.add_argument(
+        "--essential-threshold",
+        type=float,
+        metavar="PERCENT",
+        help="--method essential: remove coefficients whose relative standard deviation is "
+        "above this, one at a time while the fit holds (default 10)",
     )
 
 

@@ -431,6 +431,8 @@ def identify_log(
     options = _options(preparation)
     method = method_name(method)
     estimator_options = _estimator_options(method, estimator_options)
+    if physical and method not in LEAST_SQUARES and estimator(method).no_physical:
+        raise ValueError(f"physical: not with method {method!r}: {estimator(method).no_physical}")
     context = Context(robot, bool(rotor), kind, bool(offset), bool(position_torque))
     built = build_blocks(context)  # in column order (dynid.identification.blocks.registry)
     block_notes = [note for block in built for note in block.notes()]

@@ -6,7 +6,32 @@ Each is a function ``(Problem) -> EstimatorFit`` (:mod:`.base`) in a file of its
 
 from __future__ import annotations
 
+from . import essential, irls, tls
 from .base import EstimatorFit, Problem
 from .registry import methods, register
+
+register(
+    "irls",
+    irls.irls,
+    "robust M-estimator by iteratively reweighted least squares (outliers, reversal spikes)",
+    ("loss", "tuning"),
+)
+register(
+    "tls",
+    tls.tls,
+    "errors in variables: total least squares with the accelerations' noise (noisy regressor)",
+    ("acceleration_noise",),
+    no_physical="the physical fit minimises a weighted residual, the attenuated objective "
+    "that TLS corrects; use --method wls or irls with --physical (docs/identification.md, 'TLS')",
+)
+register(
+    "essential",
+    essential.essential,
+    "essential parameters: WLS without the coefficients the data determine poorly",
+    ("essential_threshold",),
+    no_physical="the physical fit estimates the standard parameters and cannot set base "
+    "parameters to zero; with --physical use --method wls (the constraints and a prior fix "
+    "the poorly excited directions)",
+)
 
 __all__ = ["EstimatorFit", "Problem", "methods", "register"]

@@ -22,16 +22,26 @@ class Registered:
     function: Estimator
     summary: str
     options: tuple[str, ...] = ()
+    #: why ``physical=True`` is refused with this estimator (empty: its row weights carry it)
+    no_physical: str = ""
 
 
 REGISTRY: dict[str, Registered] = {}
 
 
-def register(name: str, function: Estimator, summary: str, options: tuple[str, ...] = ()) -> None:
-    """Make ``function`` the estimator ``method=name``; ValueError when the name is taken."""
+def register(
+    name: str,
+    function: Estimator,
+    summary: str,
+    options: tuple[str, ...] = (),
+    no_physical: str = "",
+) -> None:
+    """Make ``function`` the estimator ``method=name``; ValueError when the name is taken.
+    ``no_physical``: why the estimator has no physically consistent fit (identify_log then
+    refuses ``physical=True`` with it), empty when its row weights give one."""
     if name in LEAST_SQUARES or (name in REGISTRY and REGISTRY[name].function is not function):
         raise ValueError(f"method: an estimator named {name!r} exists already")
-    REGISTRY[name] = Registered(function, summary, tuple(options))
+    REGISTRY[name] = Registered(function, summary, tuple(options), no_physical)
 
 
 def unregister(name: str) -> None:
