@@ -215,19 +215,27 @@ def test_results_written_before_the_blocks_load_and_are_reproduced(name):
     """tests/data/results_before_blocks/*.json were written by dynid 0.2 before the column
     blocks (tests/test_blocks_fixture_log.py's log, models.planar_2r()): they load, and the
     same identification today gives the same coefficients, standard deviations and training
-    fit to 1e-12 and the same file content (the dynid version aside)."""
+    fit to 1e-12 and the same file content (the dynid version aside); the symmetric model's
+    standard deviations are now the correlation-robust ones (its residuals are model error)."""
     robot = dynid.models.planar_2r()
     before = json.loads((BEFORE / f"{name}.json").read_text())
     loaded = load_result(BEFORE / f"{name}.json")
     now = identify_log(fixture_log(robot), robot, **FIXTURE_OPTIONS[name])
     assert loaded.names == now.names and loaded.blocks == now.blocks
     np.testing.assert_allclose(now.theta, loaded.theta, rtol=1e-12, atol=1e-15)
-    np.testing.assert_allclose(now.std, loaded.std, rtol=1e-12, atol=1e-15)
+    correlated = any("residuals are correlated" in note for note in now.training["notes"])
+    if correlated:
+        # The symmetric model misses the log's asymmetric friction and position torque: its
+        # residuals are model error, correlated in time, and since the files were written the
+        # standard deviations account for that (larger than the independent-samples ones).
+        assert name == "symmetric" and np.all(now.std >= loaded.std)
+    else:
+        np.testing.assert_allclose(now.std, loaded.std, rtol=1e-12, atol=1e-15)
     for key, value in loaded.training["metrics"].items():
         np.testing.assert_allclose(now.training["metrics"][key], value, rtol=1e-12, atol=1e-15)
     log = fixture_log(robot)
     np.testing.assert_allclose(now.predict(log), loaded.predict(log), rtol=0, atol=1e-12)
-    assert now.summary() == loaded.summary()
+    assert correlated or now.summary() == loaded.summary()
     data = json.loads(json.dumps(result_to_dict(now)))
     for key in ("dynid_version", "coefficients", "covariance", "training", "condition_number"):
         data.pop(key), before.pop(key)

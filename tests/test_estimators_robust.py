@@ -115,15 +115,18 @@ def test_irls_equals_an_independent_irls(loss):
 
 
 def test_irls_ignores_outliers_and_reversal_spikes():
-    """One 20 s log. WLS: Fs off by ~10 std (the reversal bursts), Fv by ~-8. Tukey: every
+    """One 20 s log. WLS: off by ~5 of its standard deviations (the reversal bursts; ~10 of the
+    independent-samples ones, but the bursts correlate the residuals, so identify reports the
+    correlation-robust ones), three times Tukey's largest error. Tukey: every
     coefficient within 3 std of the truth, and within 1 std (measured 0.77) of its own
     estimate on the same log without the spikes (it fits ~5 % fewer rows); it rejects
     (weight 0) the spikes beyond 4.685 robust sigma."""
     dirty, clean = spiky(7, 20.0), spiky(7, 20.0, spikes=False, reversals=False)
     wls = _fit(dirty, "wls")
-    assert np.abs(_z(wls)).max() > 6
+    assert np.abs(_z(wls)).max() > 4
     tukey = _fit(dirty, "irls", loss="tukey")
     assert np.abs(_z(tukey)).max() < 3, _z(tukey)
+    assert np.abs(wls.theta - TRUTH).max() > 2.5 * np.abs(tukey.theta - TRUTH).max()
     alone = _fit(clean, "irls", loss="tukey")
     assert np.abs((tukey.theta - alone.theta) / tukey.std).max() < 1.0
     injected = int(np.sum(dirty.tau != clean.tau))

@@ -120,15 +120,17 @@ def test_offsets_add_nothing_to_asymmetric_friction_in_least_squares(least_squar
 
 def test_unconstrained_gain_on_a6_a7_comes_with_negative_viscous_friction(least_squares, logs):
     """A6 and A7 drop (to 0.92 and 0.59 of the symmetric error), A5 does not (>= 1.0); the fit
-    has Fv5+, Fv5-, Fv6-, Fv7- < 0, each more than 4 of its (least-squares) standard deviations
-    below 0."""
+    has Fv5+, Fv5-, Fv6-, Fv7- < 0. The residuals are correlated (model error), so the standard
+    deviations are the correlation-robust ones, with which none of the four is significant
+    (within 2.5 of them of 0; the independent-samples ones made them 4-22 below 0)."""
     ratio = _validation(least_squares["asymmetric"], logs) / SYMMETRIC
     assert ratio[4] >= 1.0 and ratio[5] < 0.95 and ratio[6] < 0.65
     result = least_squares["asymmetric"]
+    assert any("residuals are correlated in time" in note for note in result.training["notes"])
     values = dict(zip(result.names, result.theta))
     stds = dict(zip(result.names, result.std))
     for name in ("Fv5+", "Fv5-", "Fv6-", "Fv7-"):
-        assert values[name] < -4 * stds[name], (name, values[name], stds[name])
+        assert -2.5 * stds[name] < values[name] < 0, (name, values[name], stds[name])
 
 
 def test_on_these_logs_abs_qd_is_a_function_of_q(logs):

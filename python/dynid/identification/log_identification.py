@@ -57,8 +57,14 @@ from .blocks.registry import build_blocks, friction_model
 from .blocks.rigid_body import RigidBody
 from .estimators.base import EstimatorFit, Problem
 from .estimators.registry import LEAST_SQUARES, estimator, method_name
-from .identify import VARIANCE_FLOOR, LeastSquaresResult
+from .identify import VARIANCE_FLOOR, LeastSquaresResult, relative_std
 from .physical import physical_least_squares
+from .serial_correlation import (
+    WIDTH_PER_WINDOW,
+    LongRunAccumulator,
+    autocorrelation,
+    correlation_window,
+)
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
 
@@ -72,6 +78,10 @@ DEFAULT_PRIOR_WEIGHT = 1e-5
 
 #: Samples per regressor chunk folded into the least-squares factors.
 STREAM_CHUNK = 8192
+#: Residuals whose integrated autocorrelation time (in samples, 1 for independent ones) is below
+#: this keep the independent-samples standard deviations; above it the correlation-robust ones
+#: replace them (_correlation_robust_std). White noise gives 1 +- a few hundredths.
+WHITE_CORRELATION_TIME = 1.5
 
 #: Largest training regressor (bytes) that :func:`identify_log` keeps between the least-squares
 #: pass and the prediction of the training log, so that the log's regressor is computed once;
@@ -550,6 +560,19 @@ def identify_log(
     )
     result.fitted_logs = tuple(fitted[starts[r] : starts[r + 1]] for r in range(len(runs)))
     result.fitted, result.logs = result.fitted_logs[0], tuple(runs)
+    if method in LEAST_SQUARES and standard is None:
+        # Filtered logs (and model errors) correlate the residuals of neighbouring samples: the
+        # independent-samples standard deviations would be too small (serial_correlation.py).
+        block_notes += _correlation_robust_std(
+            result,
+            fit,
+            [run.tau for run in runs],
+            row_masks,
+            starts,
+            [(r, c, cache.get(i)) for i, (r, c) in enumerate(chunks)],
+            chunk_regressor,
+            fitted,
+        )
     plain = {k: _plain(v) for k, v in options.items()}
     if len(runs) == 1:
         result.training = {
@@ -593,6 +616,85 @@ def identify_log(
         ],
     }
     return result
+
+
+def _correlation_robust_std(
+    result: LogIdentification,
+    fit: LeastSquaresResult,
+    torques: Sequence[NDArray[np.float64]],
+    row_masks: Sequence[NDArray[np.bool_] | None],
+    starts: NDArray[np.int64],
+    chunks: Sequence[tuple[int, slice, NDArray[np.float64] | None]],
+    regressor: Any,
+    fitted: NDArray[np.float64],
+) -> list[str]:
+    """Replace the least-squares standard deviations in ``result`` by those of the residuals'
+    correlation in time (the sandwich A^-1 Omega A^-1 of dynid.identification.
+    serial_correlation, Omega by the Bartlett kernel of the width the residuals show) when the
+    residuals are correlated (width > 1); the note that says so, or none. ``chunks``: (log,
+    samples, its regressor or None to compute it with ``regressor(log, samples)``)."""
+    covariance = fit.covariance
+    if covariance is None or not np.all(np.isfinite(covariance)) or fit.rank < result.theta.size:
+        return []
+    n, p = result.n, result.theta.size
+    weights = np.zeros(n)  # the fit's: 1 (OLS) or 1 / sigma_j^2 (WLS, floored as solve_factors)
+    variance = np.asarray(fit.noise_variance, dtype=float)
+    kept = list(fit.joints)
+    if result.method == "wls" and variance.size and np.all(np.isfinite(variance)):
+        largest = variance.max()
+        floored = (
+            np.maximum(variance, VARIANCE_FLOOR * largest)
+            if largest > 0
+            else np.ones_like(variance)
+        )
+        weights[kept] = 1.0 / floored
+    else:
+        weights[kept] = 1.0
+    residuals = []
+    for r, tau in enumerate(torques):
+        part = (tau - fitted[starts[r] : starts[r + 1]]) * np.sqrt(weights)
+        rows = row_masks[r]
+        residuals.append(part if rows is None else np.where(rows, part, 0.0))
+    window = correlation_window(residuals)
+    correlation_time = 1.0 + 2.0 * float(autocorrelation(residuals, window)[1:].sum())
+    if correlation_time < WHITE_CORRELATION_TIME:  # independent samples: the white covariance
+        return []
+    width = WIDTH_PER_WINDOW * window
+    A = np.zeros((p, p))
+    parts = []
+    for r, c, cached in chunks:
+        Y = cached if cached is not None else regressor(r, c)
+        rows = row_masks[r]
+        if rows is not None:
+            Y = np.where(rows[c][:, :, None], Y, 0.0)
+        WY = Y * weights[None, :, None]
+        A += np.einsum("tjp,tjq->pq", WY, Y)
+        parts.append((r, Y, WY))
+    scale = 1.0 / np.sqrt(np.where(np.diag(A) > 0, np.diag(A), 1.0))
+    inverse = scale[:, None] * np.linalg.pinv(A * scale[:, None] * scale[None, :]) * scale[None, :]
+    accumulator = LongRunAccumulator(p, width)
+    current = 0
+    for (r, c, _), (_, Y, WY) in zip(chunks, parts):
+        if r != current:
+            accumulator.end_segment()
+            current = r
+        residual = torques[r][c] - fitted[starts[r] + c.start : starts[r] + c.start + Y.shape[0]]
+        rows = row_masks[r]
+        if rows is not None:
+            residual = np.where(rows[c], residual, 0.0)
+        accumulator.add(np.einsum("tjp,tj->tp", WY, residual) @ inverse.T)
+    accumulator.end_segment()
+    robust = accumulator.omega
+    std = np.sqrt(np.maximum(np.diag(robust), 0.0))
+    ratio = std / np.where(result.std > 0, result.std, np.inf)
+    result.covariance, result.std = robust, std
+    result.relative_std = relative_std(result.theta, std)
+    return [
+        f"the residuals are correlated in time (integrated correlation time "
+        f"{correlation_time:.3g} samples, e.g. a filtered log or a model error): standard "
+        f"deviations from that correlation (Newey-West, Bartlett width {width}), "
+        f"{np.nanmin(ratio):.2g}-{np.nanmax(ratio):.2g} times the independent-samples ones"
+    ]
 
 
 def _estimator_options(method: str, options: Mapping[str, Any] | None) -> dict[str, Any]:

@@ -96,3 +96,45 @@ def long_run_covariance(
         scale = T / (T - L + 1) * (T / (T - L) if T > L else 1.0)
         omega += batches.T @ batches / L * scale
     return omega
+
+
+class LongRunAccumulator:
+    """:func:`long_run_covariance` of h_t fed chunk by chunk (a log of any length: memory of
+    ``width`` samples, not of the log): overlapping batch means of ``width`` consecutive h_t,
+    a segment (one log) at a time; :meth:`end_segment` between logs, so that no batch spans two.
+    """
+
+    def __init__(self, p: int, width: int) -> None:
+        self.p, self.width = int(p), max(1, int(width))
+        self.omega = np.zeros((self.p, self.p))
+        self._tail = np.zeros((0, self.p))  # the last ``width`` cumulative sums of the segment
+        self._total = np.zeros(self.p)
+        self._count = 0
+        self._batches = np.zeros((self.p, self.p))
+
+    def add(self, h: NDArray[np.float64]) -> None:
+        """Add the next (T_k, p) h_t of the current segment."""
+        if h.shape[0] == 0:
+            return
+        cumulative = self._total + np.cumsum(h, axis=0)
+        if self._count == 0:
+            cumulative = np.vstack([np.zeros(self.p), cumulative])
+        known = np.vstack([self._tail, cumulative])
+        L = self.width
+        if known.shape[0] > L:
+            batches = known[L:] - known[:-L]
+            self._batches += batches.T @ batches
+        self._tail = known[-L:]
+        self._total = cumulative[-1]
+        self._count += h.shape[0]
+
+    def end_segment(self) -> None:
+        """Close the current segment (with the factors of :func:`long_run_covariance`)."""
+        T, L = self._count, min(self.width, max(self._count, 1))
+        if T:  # the factors of long_run_covariance (none for white rows, L = 1)
+            scale = 1.0 if L == 1 else T / (T - L + 1) * (T / (T - L) if T > L else 1.0)
+            self.omega += self._batches / L * scale
+        self._tail = np.zeros((0, self.p))
+        self._total = np.zeros(self.p)
+        self._count = 0
+        self._batches = np.zeros((self.p, self.p))
