@@ -11,6 +11,7 @@ inequalities; only the objective is nonlinear. SLSQP minimises it with the analy
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -35,6 +36,7 @@ from .trajectory import (
     excitation_condition_number,
     rest_to_rest,
 )
+from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_limit_vector, torque_scale
 
 #: Default distance kept from each joint limit, as a fraction of the joint's range.
 DEFAULT_POSITION_MARGIN = 0.02
@@ -85,6 +87,9 @@ def optimize_excitation(
     maxiter: int = 200,
     initial: FourierTrajectory | None = None,
     position_margin: float = DEFAULT_POSITION_MARGIN,
+    tau_max: ArrayLike | None = None,
+    torque_model: Robot | None = None,
+    progress: Callable[[int, float], None] | None = None,
 ) -> ExcitationResult:
     """Fourier coefficients and offsets minimising the condition number of the base regressor.
 
@@ -96,6 +101,13 @@ def optimize_excitation(
     random trajectory drawn with ``seed``, scaled to the limits. The result is afterwards checked
     on a grid CHECK_OVERSAMPLING times denser, with a bound on the excursion between its points,
     and its amplitudes shrunk about q0 if needed, so it meets every limit over the whole period.
+
+    ``tau_max`` (a scalar or (n,), None: no torque limit) adds |tau| <= tau_max, the torque of
+    ``torque_model`` (default ``robot``; e.g. a prior model with the drive terms) by rnea along
+    the motion: SLSQP sees it on the constraint points with TORQUE_MARGIN kept free, and the
+    start and the result are shrunk about q0 until the bound of
+    :func:`dynid.excitation.torque_limits.torque_extents` holds over the whole period.
+    ``progress(iteration, cond)`` is called after each SLSQP iteration.
     """
     n = robot.n
     harmonics = _integer(harmonics, "harmonics", minimum=2 if at_rest else 1)
@@ -119,20 +131,31 @@ def optimize_excitation(
     low, high = robot.qlim[:, 0] + margin * span, robot.qlim[:, 1] - margin * span
     wf = 2.0 * np.pi / period
     limits = (np.column_stack([low, high]), vel, acc)
+    torque = None if tau_max is None else torque_limit_vector(tau_max, n)
+    model = robot if torque_model is None else torque_model
+    if torque is not None and (not isinstance(model, Robot) or model.n != n):
+        raise ValueError(f"torque_model: expected a Robot with {n} joints, got {model!r}")
+    check = CHECK_OVERSAMPLING * samples
 
     if initial is None:
         start = _random_start(np.random.default_rng(seed), n, harmonics, wf, low, high, at_rest)
     else:
         start = _check_initial(initial, n, harmonics, period, low, high, at_rest)
-    scale = _limit_scale(start, *limits, CHECK_OVERSAMPLING * samples)
+    scale = _limit_scale(start, *limits, check)
     # a random start is stretched to touch the nearest limit, a given one only shrunk if needed
     start = _scaled(start, scale if initial is None else min(scale, 1.0))
+    if torque is not None:  # then shrunk until its torque is within the limits everywhere
+        start = _scaled(start, torque_scale(model, start, torque, check))
 
     t = period * np.arange(samples) / samples
     objective = _LogCondition(robot, base, t, wf, harmonics, rotor, friction)
     m = min(samples, CONSTRAINT_POINTS_PER_HARMONIC * harmonics)
     grid = _basis(period * np.arange(m) / m, wf, harmonics)
     constraints: list[Any] = [_inequalities(grid, n, low, high, vel, acc)]  # SciPy's dicts
+    if torque is not None:
+        points = period * np.arange(m) / m
+        limit = (1.0 - TORQUE_MARGIN) * torque
+        constraints.append(TorqueConstraint(model, points, wf, harmonics, limit).as_dict())
     if at_rest:
         constraints.append(_rest_equalities(n, harmonics))
     x0 = start.to_vector()
@@ -144,6 +167,7 @@ def optimize_excitation(
             method="SLSQP",
             constraints=constraints,
             options={"maxiter": maxiter, "ftol": TOLERANCE},
+            callback=None if progress is None else _Progress(progress, objective),
         )
         x, iterations, success, message = (
             result.x,
@@ -160,7 +184,9 @@ def optimize_excitation(
     # q0 is the mean of q over the constraint points, so inside the limits unless SLSQP stopped
     # infeasible; clipping keeps the scaling below well defined in that case too.
     final = FourierTrajectory(wf, final.a, final.b, np.clip(final.q0, low, high))
-    scale = _limit_scale(final, *limits, CHECK_OVERSAMPLING * samples)
+    scale = _limit_scale(final, *limits, check)
+    if torque is not None:
+        scale = min(scale, 1.0) * torque_scale(model, _scaled(final, min(scale, 1.0)), torque, check)
     if scale < 1.0:
         final = _scaled(final, scale)
         message += f"; amplitudes scaled by {scale:.6f} to meet the limits between samples"
@@ -171,6 +197,17 @@ def optimize_excitation(
         final, after, success = start, before, False
         message += "; no improvement on the initial guess, which is returned"
     return ExcitationResult(final, before, after, iterations, success, message, start)
+
+
+class _Progress:
+    """SLSQP's callback: ``report(iteration, cond)`` after each iteration."""
+
+    def __init__(self, report: Callable[[int, float], None], objective: _LogCondition) -> None:
+        self.report, self.objective, self.iteration = report, objective, 0
+
+    def __call__(self, x: NDArray[np.float64]) -> None:
+        self.iteration += 1
+        self.report(self.iteration, float(np.exp(self.objective.value(x))))
 
 
 # ---- the objective ----------------------------------------------------------------------------
