@@ -54,6 +54,10 @@ TOLERANCE = 1e-4
 #: The returned trajectory is checked on a grid this many times denser than ``samples``.
 CHECK_OVERSAMPLING = 10
 
+#: With torque limits, random starts drawn at most this many times to find a mean position q0
+#: where gravity leaves room for the motion (_start_within_gravity).
+START_DRAWS = 100
+
 # Central-difference step in q for the regressor's derivative (error ~h^2, rounding ~1e-16/h).
 _Q_STEP = 1e-5
 
@@ -138,7 +142,10 @@ def optimize_excitation(
     check = CHECK_OVERSAMPLING * samples
 
     if initial is None:
-        start = _random_start(np.random.default_rng(seed), n, harmonics, wf, low, high, at_rest)
+        rng = np.random.default_rng(seed)
+        start = _random_start(rng, n, harmonics, wf, low, high, at_rest)
+        if torque is not None:
+            start = _start_within_gravity(rng, start, model, torque, low, high, at_rest)
     else:
         start = _check_initial(initial, n, harmonics, period, low, high, at_rest)
     scale = _limit_scale(start, *limits, check)
@@ -186,7 +193,9 @@ def optimize_excitation(
     final = FourierTrajectory(wf, final.a, final.b, np.clip(final.q0, low, high))
     scale = _limit_scale(final, *limits, check)
     if torque is not None:
-        scale = min(scale, 1.0) * torque_scale(model, _scaled(final, min(scale, 1.0)), torque, check)
+        scale = min(scale, 1.0) * torque_scale(
+            model, _scaled(final, min(scale, 1.0)), torque, check
+        )
     if scale < 1.0:
         final = _scaled(final, scale)
         message += f"; amplitudes scaled by {scale:.6f} to meet the limits between samples"
@@ -370,6 +379,30 @@ def _random_start(
         a, b = _rest_projection(a, b)
     q0 = low + (high - low) * rng.uniform(0.25, 0.75, n)
     return FourierTrajectory(wf, a, b, q0)
+
+
+def _start_within_gravity(
+    rng: np.random.Generator,
+    start: FourierTrajectory,
+    model: Robot,
+    torque: NDArray,
+    low: NDArray,
+    high: NDArray,
+    at_rest: bool,
+) -> FourierTrajectory:
+    """The random start redrawn (up to START_DRAWS times) until gravity at q0 takes at most half
+    of each torque limit, leaving the other half to the motion; else the draw needing least."""
+    best, best_load = start, np.inf
+    for _ in range(START_DRAWS):
+        load = float(np.max(np.abs(model.gravity(start.q0)) / torque))
+        if load < best_load:
+            best, best_load = start, load
+        if load <= 0.5:
+            break
+        start = _random_start(
+            rng, start.n, start.harmonics, start.base_frequency, low, high, at_rest
+        )
+    return best
 
 
 def _check_initial(

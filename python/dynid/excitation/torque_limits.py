@@ -124,9 +124,9 @@ def torque_extents(model: Robot, trajectory: FourierTrajectory, samples: int) ->
     # in wf t has |p'| <= H wf max|p|), so on an interval w >= its linear interpolation minus
     # |w''| h^2 / 8: with one sign at both ends and both ends farther than that from zero, w
     # keeps its sign throughout.
-    w_curve = np.abs(T) @ (trajectory.harmonics * trajectory.base_frequency * _extents(
-        trajectory, samples
-    )[3])
+    w_curve = np.abs(T) @ (
+        trajectory.harmonics * trajectory.base_frequency * _extents(trajectory, samples)[3]
+    )
 
     def neighbours(values: NDArray) -> NDArray:  # max over each interval's two ends (periodic)
         return np.maximum(values, np.roll(values, -1, axis=0))
