@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from coupled_robots import coupled_puma
 
 import dynid
+from coupled_robots import coupled_puma
 from dynid.excitation import FourierTrajectory, optimize_excitation, rest_to_rest
 from dynid.excitation.torque_limits import TorqueConstraint, torque_extents, torque_scale
 

@@ -10,8 +10,8 @@ inequalities; only the objective is nonlinear. SLSQP minimises it with the analy
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -21,6 +21,7 @@ from scipy.optimize import minimize
 from .._threads import blas_single_threaded
 from ..model.base_parameters import BaseParameters, base_parameters
 from ..model.robot import Robot
+from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_limit_vector, torque_scale
 from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,
@@ -36,7 +37,6 @@ from .trajectory import (
     excitation_condition_number,
     rest_to_rest,
 )
-from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_limit_vector, torque_scale
 
 #: Default distance kept from each joint limit, as a fraction of the joint's range.
 DEFAULT_POSITION_MARGIN = 0.02

@@ -177,7 +177,8 @@ def _scaled(trajectory: FourierTrajectory, factor: float) -> FourierTrajectory:
 
 def _jerk_and_snap(trajectory: FourierTrajectory, t: NDArray) -> tuple[NDArray, NDArray]:
     """The third and fourth time derivatives of the series at ``t``, (T, n) each:
-    qddd_i = sum_l (wf l)^2 (-a_il cos - b_il sin), qdddd_i = sum_l (wf l)^3 (a_il sin - b_il cos)."""
+    qddd_i = sum_l (wf l)^2 (-a_il cos - b_il sin),
+    qdddd_i = sum_l (wf l)^3 (a_il sin - b_il cos)."""
     w = trajectory.base_frequency * np.arange(1, trajectory.harmonics + 1)
     S, C = np.sin(np.outer(t, w)), np.cos(np.outer(t, w))
     a, b = trajectory.a, trajectory.b
