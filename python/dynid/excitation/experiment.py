@@ -6,14 +6,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
 from numpy.typing import ArrayLike
 
 from ..model.robot import Robot
 from .optimization import DEFAULT_POSITION_MARGIN, ExcitationResult, optimize_excitation
+from .torque_limits import torque_limit_vector
 from .trajectory import DEFAULT_QD_MAX, DEFAULT_QDD_MAX, _integer, _limit_vector
 from .trajectory_files import ExperimentTrajectory
-from .torque_limits import torque_limit_vector
 
 
 def design_experiment(

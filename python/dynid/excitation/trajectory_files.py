@@ -94,7 +94,9 @@ class ExperimentTrajectory:
         """t = k / rate for k = 0, 1, ... up to and including the duration (rate in Hz)."""
         value = _finite_array(rate, "rate")
         if value.ndim != 0 or not value > 0:
-            raise ValueError(f"rate: expected a positive number of samples per second, got {rate!r}")
+            raise ValueError(
+                f"rate: expected a positive number of samples per second, got {rate!r}"
+            )
         count = int(np.floor(self.duration * float(value) + 1e-9)) + 1
         return np.arange(count) / float(value)
 

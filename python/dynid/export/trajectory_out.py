@@ -4,9 +4,10 @@ Written into one folder, whole or not at all (:func:`dynid.export.output_folder.
 
 - ``trajectory.json``: :func:`dynid.excitation.trajectory_files.trajectory_to_dict`, read back by
   :func:`dynid.excitation.load_trajectory`;
-- ``trajectory.csv``: dynid's CSV log layout (docs/data.md, "CSV": ``t,q1..,qd1..,qdd1..,tau1..``,
-  each number in the shortest text that reads back exactly) at the controller rate, tau the torque the model predicts; the joint
-  names in a comment line, so that ``dynid.load_log`` reads it as a log;
+- ``trajectory.csv``: dynid's CSV log layout (docs/data.md, "CSV":
+  ``t,q1..,qd1..,qdd1..,tau1..``, each number in the shortest text that reads back exactly) at
+  the controller rate, tau the torque the model predicts; the joint names in a comment line, so
+  that ``dynid.load_log`` reads it as a log;
 - ``trajectory_ros.yaml``: a ROS 2 ``trajectory_msgs/msg/JointTrajectory`` as YAML;
 - ``trajectory.hpp``: :mod:`dynid.export.trajectory_cpp`.
 """
