@@ -476,6 +476,9 @@ def excite(args: argparse.Namespace) -> None:
     inputs = [args.model, args.prior]
     check_output_path(args.output, args.overwrite, inputs=inputs)
     check_links(args, args.model, args.prior)
+    for option, rate in (("--rate", args.rate), ("--ros-rate", args.ros_rate)):
+        if not (np.isfinite(rate) and rate > 0):  # checked before the optimisation, not after
+            raise ValueError(f"{option}: expected a positive rate [Hz], got {rate:g}")
     robot = load_robot(args, args.model).copy()
     prior = None if args.prior is None else load_robot(args, args.prior)
     if prior is not None and prior.n != robot.n:

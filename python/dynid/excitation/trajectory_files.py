@@ -31,6 +31,10 @@ FORMAT = "dynid-trajectory"
 VERSION = 1
 RAMPS = ("rest_to_rest",)
 
+#: Times this close to a multiple of the period [s] are rest instants (qd, qdd set to 0; their
+#: true values are below 1e-17 there: qd ~ jerk t^2 / 2).
+REST_SNAP = 1e-9
+
 # A rest-to-rest series has qd(0) = qdd(0) = 0 up to rounding of its coefficients.
 _REST_TOLERANCE = 1e-9
 
@@ -86,9 +90,15 @@ class ExperimentTrajectory:
         self, t: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """q, qd, qdd at times ``t`` (see FourierTrajectory.evaluate), t clamped to
-        [0, duration]: at rest outside."""
+        [0, duration]: at rest outside. At the rest instants (multiples of the period, within
+        REST_SNAP) qd and qdd are exactly 0, not rounding noise of either sign, so that a
+        torque predicted there has the Coulomb term sign(0) = 0."""
         times = np.clip(_finite_array(t, "t"), 0.0, self.duration)
-        return self.trajectory.evaluate(times)
+        q, qd, qdd = self.trajectory.evaluate(times)
+        period = self.trajectory.period
+        rest = np.abs(times - period * np.round(times / period)) <= REST_SNAP
+        qd, qdd = np.where(rest[..., None] if rest.ndim else rest, 0.0, (qd, qdd))
+        return q, qd, qdd
 
     def times(self, rate: float) -> NDArray[np.float64]:
         """t = k / rate for k = 0, 1, ... up to and including the duration (rate in Hz)."""
