@@ -41,7 +41,7 @@ def test_excite_writes_a_trajectory_within_every_limit(tmp_path, capsys) -> None
     assert np.abs(qd).max() <= 0.8 and np.abs(qdd).max() <= 1.5
     assert np.all(np.abs(robot.rnea(q, qd, qdd)) <= np.array(limits["tau_max"]))
     log = dynid.load_log(out / "trajectory.csv")
-    assert log.t.size == int(6 * 250) + 1 and log.t[-1] == pytest.approx(6.0, abs=1e-12)
+    assert log.t.size == (6 * 250) + 1 and log.t[-1] == pytest.approx(6.0, abs=1e-12)
 
 
 def test_urdf_velocity_and_effort_limits_are_used(tmp_path) -> None:

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from cpp_programs import find_compiler
 
 import dynid
+from cpp_programs import find_compiler
 from dynid.excitation import ExperimentTrajectory, FourierTrajectory, load_trajectory, rest_to_rest
 from dynid.excitation.joint_limits import urdf_velocity_effort
 from dynid.export.trajectory_out import FILES, save_trajectory_folder
