@@ -21,7 +21,15 @@ from scipy.optimize import minimize
 from .._threads import blas_single_threaded
 from ..model.base_parameters import BaseParameters, base_parameters
 from ..model.robot import Robot
-from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_limit_vector, torque_scale
+from .cartesian import (
+    KeepOut,
+    KeepOutConstraint,
+    capsule_pairs,
+    constraint_labels,
+    constraint_values,
+    keep_out_holds,
+)
+from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_extents, torque_limit_vector
 from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,
@@ -93,6 +101,7 @@ def optimize_excitation(
     position_margin: float = DEFAULT_POSITION_MARGIN,
     tau_max: ArrayLike | None = None,
     torque_model: Robot | None = None,
+    keep_out: KeepOut | None = None,
     progress: Callable[[int, float], None] | None = None,
 ) -> ExcitationResult:
     """Fourier coefficients and offsets minimising the condition number of the base regressor.
@@ -111,6 +120,10 @@ def optimize_excitation(
     the motion: SLSQP sees it on the constraint points with TORQUE_MARGIN kept free, and the
     start and the result are shrunk about q0 until the bound of
     :func:`dynid.excitation.torque_limits.torque_extents` holds over the whole period.
+    ``keep_out`` (:class:`dynid.excitation.cartesian.KeepOut`) keeps the link origins and the
+    tool point above a floor and inside a box, and non-adjacent links (capsules) apart: SLSQP
+    sees them on the constraint points with ``keep_out.margin`` free, and the start and the result
+    are shrunk about q0 until they hold over the whole period (cartesian.keep_out_holds).
     ``progress(iteration, cond)`` is called after each SLSQP iteration.
     """
     n = robot.n
@@ -139,30 +152,39 @@ def optimize_excitation(
     model = robot if torque_model is None else torque_model
     if torque is not None and (not isinstance(model, Robot) or model.n != n):
         raise ValueError(f"torque_model: expected a Robot with {n} joints, got {model!r}")
+    if keep_out is not None and not isinstance(keep_out, KeepOut):
+        raise ValueError(f"keep_out: expected a KeepOut, got {type(keep_out).__name__}")
+    space = keep_out if keep_out is not None and keep_out.active else None
     check = CHECK_OVERSAMPLING * samples
 
     if initial is None:
         rng = np.random.default_rng(seed)
         start = _random_start(rng, n, harmonics, wf, low, high, at_rest)
-        if torque is not None:
-            start = _start_within_gravity(rng, start, model, torque, low, high, at_rest)
+        if torque is not None or space is not None:
+            start = _start_with_room(rng, start, robot, model, torque, space, low, high, at_rest)
     else:
         start = _check_initial(initial, n, harmonics, period, low, high, at_rest)
     scale = _limit_scale(start, *limits, check)
     # a random start is stretched to touch the nearest limit, a given one only shrunk if needed
     start = _scaled(start, scale if initial is None else min(scale, 1.0))
-    if torque is not None:  # then shrunk until its torque is within the limits everywhere
-        start = _scaled(start, torque_scale(model, start, torque, check))
+    q_ref = start.q0  # the configuration the capsules' segment lengths are measured at
+    nonlinear = _NonlinearLimits(robot, model, torque, space, q_ref, check)
+    # then shrunk until its torque and keep-out limits hold everywhere
+    start = _scaled(start, nonlinear.scale(start))
 
     t = period * np.arange(samples) / samples
     objective = _LogCondition(robot, base, t, wf, harmonics, rotor, friction)
     m = min(samples, CONSTRAINT_POINTS_PER_HARMONIC * harmonics)
     grid = _basis(period * np.arange(m) / m, wf, harmonics)
     constraints: list[Any] = [_inequalities(grid, n, low, high, vel, acc)]  # SciPy's dicts
+    points = period * np.arange(m) / m
     if torque is not None:
-        points = period * np.arange(m) / m
         limit = (1.0 - TORQUE_MARGIN) * torque
         constraints.append(TorqueConstraint(model, points, wf, harmonics, limit).as_dict())
+    if space is not None:
+        # the Cartesian motion needs a finer grid than the joints' 20 H: samples points
+        keep_t = period * np.arange(samples) / samples
+        constraints.append(KeepOutConstraint(robot, space, keep_t, wf, harmonics, q_ref).as_dict())
     if at_rest:
         constraints.append(_rest_equalities(n, harmonics))
     x0 = start.to_vector()
@@ -192,10 +214,8 @@ def optimize_excitation(
     # infeasible; clipping keeps the scaling below well defined in that case too.
     final = FourierTrajectory(wf, final.a, final.b, np.clip(final.q0, low, high))
     scale = _limit_scale(final, *limits, check)
-    if torque is not None:
-        scale = min(scale, 1.0) * torque_scale(
-            model, _scaled(final, min(scale, 1.0)), torque, check
-        )
+    if torque is not None or space is not None:
+        scale = min(scale, 1.0) * nonlinear.scale(_scaled(final, min(scale, 1.0)))
     if scale < 1.0:
         final = _scaled(final, scale)
         message += f"; amplitudes scaled by {scale:.6f} to meet the limits between samples"
@@ -381,28 +401,98 @@ def _random_start(
     return FourierTrajectory(wf, a, b, q0)
 
 
-def _start_within_gravity(
+def _start_with_room(
     rng: np.random.Generator,
     start: FourierTrajectory,
+    robot: Robot,
     model: Robot,
-    torque: NDArray,
+    torque: NDArray | None,
+    space: KeepOut | None,
     low: NDArray,
     high: NDArray,
     at_rest: bool,
 ) -> FourierTrajectory:
     """The random start redrawn (up to START_DRAWS times) until gravity at q0 takes at most half
-    of each torque limit, leaving the other half to the motion; else the draw needing least."""
+    of each torque limit, leaving the other half to the motion, and the arm standing at q0 is
+    outside the keep-out by twice its margin; else the draw needing least."""
     best, best_load = start, np.inf
     for _ in range(START_DRAWS):
-        load = float(np.max(np.abs(model.gravity(start.q0)) / torque))
+        load = 0.0
+        if torque is not None:
+            load = float(np.max(np.abs(model.gravity(start.q0)) / torque)) / 0.5
+        if space is not None:
+            values = _keep_out_at(robot, space, start.q0, start.q0)
+            room = float(values.min(initial=np.inf)) / (2 * space.margin + 1e-12)
+            load = max(load, 2.0 - min(room, 2.0))  # 1 when the room is exactly twice the margin
         if load < best_load:
             best, best_load = start, load
-        if load <= 0.5:
+        if load <= 1.0:
             break
         start = _random_start(
             rng, start.n, start.harmonics, start.base_frequency, low, high, at_rest
         )
     return best
+
+
+def _keep_out_at(robot: Robot, space: KeepOut, q: NDArray, q_ref: NDArray) -> NDArray:
+    radii, pairs = capsule_pairs(robot, space, q_ref)
+    return constraint_values(robot, space, radii, pairs, np.atleast_2d(q))[0][0]
+
+
+class _NonlinearLimits:
+    """The torque and keep-out limits over the whole period, and the largest amplitude factor
+    (about q0) that meets them."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        model: Robot,
+        torque: NDArray | None,
+        space: KeepOut | None,
+        q_ref: NDArray,
+        samples: int,
+    ) -> None:
+        self.robot, self.model, self.torque, self.space = robot, model, torque, space
+        self.q_ref, self.samples = q_ref, samples
+
+    def holds(self, trajectory: FourierTrajectory) -> bool:
+        if self.torque is not None and np.any(
+            torque_extents(self.model, trajectory, self.samples) > self.torque
+        ):
+            return False
+        return self.space is None or keep_out_holds(
+            self.robot, self.space, trajectory, self.samples, self.q_ref
+        )
+
+    def scale(self, trajectory: FourierTrajectory) -> float:
+        """1.0 if ``trajectory`` holds, else the largest factor found by bisection (to 1e-6) whose
+        scaled trajectory holds; ValueError when even standing at q0 does not (factor 0)."""
+        if self.holds(trajectory):
+            return 1.0
+        q0 = trajectory.q0
+        if self.torque is not None:
+            at_rest = np.abs(self.model.gravity(q0))
+            if np.any(at_rest > self.torque):
+                joint = int(np.argmax(at_rest - self.torque))
+                raise ValueError(
+                    f"tau_max: the gravity torque at the mean position q0 alone "
+                    f"({at_rest[joint]:.4g}) exceeds the limit of joint {joint + 1} "
+                    f"({self.torque[joint]:.4g}): no amplitude helps"
+                )
+        if self.space is not None:
+            values = _keep_out_at(self.robot, self.space, q0, self.q_ref)
+            if np.any(values < 0):
+                _, pairs = capsule_pairs(self.robot, self.space, self.q_ref)
+                label = constraint_labels(self.robot.n, self.space, pairs)[int(np.argmin(values))]
+                raise ValueError(
+                    f"keep_out: the arm standing at the mean position q0 violates it ({label}, "
+                    f"by {-values.min():.4g} m): no amplitude helps"
+                )
+        low, high = 0.0, 1.0  # low always holds (0: standing still at q0)
+        while high - low > 1e-6:
+            middle = 0.5 * (low + high)
+            low, high = (middle, high) if self.holds(_scaled(trajectory, middle)) else (low, middle)
+        return low
 
 
 def _check_initial(
