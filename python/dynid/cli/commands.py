@@ -494,6 +494,7 @@ def excite(args: argparse.Namespace) -> None:
     qd_max = _limit_option(args.qd_max, urdf_velocity, 1.0, robot.n, "--qd-max")
     qdd_max = _limit_option(args.qdd_max, None, 2.0, robot.n, "--qdd-max")
     tau_max = _limit_option(args.tau_max, urdf_effort, None, robot.n, "--tau-max")
+    keep_out = _keep_out(args)
     start = time.perf_counter()
     last = [start]
 
@@ -522,6 +523,7 @@ def excite(args: argparse.Namespace) -> None:
         friction=args.friction,
         seed=args.seed,
         maxiter=args.maxiter,
+        keep_out=keep_out,
         progress=progress,
     )
     save_trajectory_folder(
@@ -547,6 +549,25 @@ def excite(args: argparse.Namespace) -> None:
         f"trajectory_ros.yaml ({args.ros_rate:g} Hz), trajectory.hpp",
         flush=True,
     )
+
+
+def _keep_out(args: argparse.Namespace) -> Any:
+    """--floor, --box, --capsule-radius, --keep-out-margin as a KeepOut (None without any)."""
+    if args.floor is None and args.box is None and args.capsule_radius is None:
+        return None
+    from ..excitation.cartesian import KeepOut
+
+    options = {"floor": "--floor", "box": "--box", "radii": "--capsule-radius"}
+    try:
+        return KeepOut(
+            floor=args.floor,
+            box=None if args.box is None else tuple(args.box),
+            radii=None if args.capsule_radius is None else args.capsule_radius,
+            margin=args.keep_out_margin,
+        )
+    except ValueError as exc:  # name the option, not the field
+        field, _, rest = str(exc).partition(":")
+        raise ValueError(f"{options.get(field, '--keep-out-margin')}:{rest}") from None
 
 
 def _joint_values(values: list[float], n: int, option: str) -> Any:

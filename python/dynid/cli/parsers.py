@@ -296,6 +296,35 @@ def _add_excite(subcommands: Any) -> None:
         metavar="HZ",
         help="points per second of trajectory_ros.yaml (default 100; controllers interpolate)",
     )
+    p.add_argument(
+        "--floor",
+        type=float,
+        metavar="Z",
+        help="keep the link origins and the tool point above the plane z = Z [m, world frame]",
+    )
+    p.add_argument(
+        "--box",
+        type=float,
+        nargs=6,
+        metavar=("XMIN", "XMAX", "YMIN", "YMAX", "ZMIN", "ZMAX"),
+        help="keep the link origins and the tool point inside this box [m, world frame]",
+    )
+    p.add_argument(
+        "--capsule-radius",
+        type=_per_joint,
+        metavar="R",
+        help="keep non-adjacent links apart, each a capsule of this radius [m] about the segment "
+        "between consecutive DH frame origins (n + 1 segments, the last to the tool point; one "
+        "radius or n + 1)",
+    )
+    p.add_argument(
+        "--keep-out-margin",
+        type=float,
+        default=0.05,
+        metavar="M",
+        help="free distance [m] the optimiser keeps from the floor, box and capsules on its "
+        "grid (default 0.05)",
+    )
     p.add_argument("--rotor", action="store_true", help="excite the rotor inertia columns too")
     p.add_argument("--friction", action="store_true", help="excite the friction columns too")
     p.add_argument("--seed", type=int, default=0, help="random start (default 0)")

@@ -105,7 +105,7 @@ def capsule_pairs(robot: Robot, keep_out: KeepOut, q: NDArray) -> tuple[NDArray,
         return np.zeros(segments), np.zeros((0, 2), dtype=int)
     radii = (
         np.broadcast_to(np.asarray(keep_out.radii, dtype=float), (segments,)).copy()
-        if (np.ndim(keep_out.radii) == 0 or np.size(keep_out.radii) == segments)
+        if (np.size(keep_out.radii) in (1, segments))
         else None
     )
     if radii is None:
