@@ -170,7 +170,8 @@ def test_a_keep_out_the_arm_cannot_leave_is_an_error(ur5) -> None:
 def test_cli_keep_out_options(tmp_path, capsys) -> None:
     out = tmp_path / "ur5"
     argv = ["excite", "--model", "ur5", "--q-min=-2.3", "--q-max", "2.3", "--harmonics", "2"]
-    argv += ["--samples", "40", "--maxiter", "5", "--floor", "0", "--box", "-0.7", "0.7"]
+    argv += ["--samples", "40", "--maxiter", "3", "--rate", "100", "--ros-rate", "10"]
+    argv += ["--floor", "0", "--box", "-0.7", "0.7"]
     argv += ["-0.7", "0.7", "-1", "1", "--capsule-radius", "0.05", "--output", str(out)]
     assert main(argv) == 0
     plan = load_trajectory(out)
