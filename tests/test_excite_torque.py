@@ -14,7 +14,8 @@ import pytest
 import dynid
 from coupled_robots import coupled_puma
 from dynid.excitation import FourierTrajectory, optimize_excitation, rest_to_rest
-from dynid.excitation.torque_limits import TorqueConstraint, torque_extents, torque_scale
+from dynid.excitation.limit_scaling import NonlinearLimits
+from dynid.excitation.torque_limits import TorqueConstraint, torque_extents
 
 SEED = 20261127
 
@@ -87,18 +88,19 @@ def test_torque_bound_of_a_coupled_wrist_holds_on_a_dense_grid() -> None:
     assert np.all(torque_extents(robot, traj, 400) >= dense_torque(robot, traj, 40_000))
 
 
-def test_torque_scale_meets_the_limits_or_names_gravity(lwr) -> None:
+def test_amplitude_scaling_meets_the_torque_limits_or_names_gravity(lwr) -> None:
     rng = np.random.default_rng(SEED + 3)
     traj = random_trajectory(rng, lwr.n, amplitude=1.0)
     peak = dense_torque(lwr, traj, 40_000)
     gravity = np.abs(lwr.gravity(traj.q0))
     limit = 0.5 * (peak + gravity) + 0.5  # between standing at q0 and the motion's peak
-    factor = torque_scale(lwr, traj, limit, 400)
+    factor = NonlinearLimits(lwr, lwr, limit, None, traj.q0, 400).scale(traj)
     assert 0.0 < factor < 1.0
     shrunk = FourierTrajectory(traj.base_frequency, factor * traj.a, factor * traj.b, traj.q0)
     assert np.all(dense_torque(lwr, shrunk, 40_000) <= limit)
+    tight = NonlinearLimits(lwr, lwr, np.maximum(0.5 * gravity, 1e-3), None, traj.q0, 400)
     with pytest.raises(ValueError, match="tau_max: the gravity torque"):
-        torque_scale(lwr, traj, np.maximum(0.5 * gravity, 1e-3), 400)
+        tight.scale(traj)
 
 
 # a small case as in test_excitation.py: 2 harmonics, 40 samples, a few SLSQP iterations

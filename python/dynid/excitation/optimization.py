@@ -21,15 +21,9 @@ from scipy.optimize import minimize
 from .._threads import blas_single_threaded
 from ..model.base_parameters import BaseParameters, base_parameters
 from ..model.robot import Robot
-from .cartesian import (
-    KeepOut,
-    KeepOutConstraint,
-    capsule_pairs,
-    constraint_labels,
-    constraint_values,
-    keep_out_holds,
-)
-from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_extents, torque_limit_vector
+from .cartesian import KeepOut, KeepOutConstraint
+from .limit_scaling import NonlinearLimits, start_with_room
+from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_limit_vector
 from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,
@@ -61,10 +55,6 @@ TOLERANCE = 1e-4
 
 #: The returned trajectory is checked on a grid this many times denser than ``samples``.
 CHECK_OVERSAMPLING = 10
-
-#: With torque limits, random starts drawn at most this many times to find a mean position q0
-#: where gravity leaves room for the motion (_start_within_gravity).
-START_DRAWS = 100
 
 # Central-difference step in q for the regressor's derivative (error ~h^2, rounding ~1e-16/h).
 _Q_STEP = 1e-5
@@ -161,14 +151,18 @@ def optimize_excitation(
         rng = np.random.default_rng(seed)
         start = _random_start(rng, n, harmonics, wf, low, high, at_rest)
         if torque is not None or space is not None:
-            start = _start_with_room(rng, start, robot, model, torque, space, low, high, at_rest)
+
+            def redraw() -> FourierTrajectory:
+                return _random_start(rng, n, harmonics, wf, low, high, at_rest)
+
+            start = start_with_room(start, redraw, robot, model, torque, space)
     else:
         start = _check_initial(initial, n, harmonics, period, low, high, at_rest)
     scale = _limit_scale(start, *limits, check)
     # a random start is stretched to touch the nearest limit, a given one only shrunk if needed
     start = _scaled(start, scale if initial is None else min(scale, 1.0))
     q_ref = start.q0  # the configuration the capsules' segment lengths are measured at
-    nonlinear = _NonlinearLimits(robot, model, torque, space, q_ref, check)
+    nonlinear = NonlinearLimits(robot, model, torque, space, q_ref, check)
     # then shrunk until its torque and keep-out limits hold everywhere
     start = _scaled(start, nonlinear.scale(start))
 
@@ -399,100 +393,6 @@ def _random_start(
         a, b = _rest_projection(a, b)
     q0 = low + (high - low) * rng.uniform(0.25, 0.75, n)
     return FourierTrajectory(wf, a, b, q0)
-
-
-def _start_with_room(
-    rng: np.random.Generator,
-    start: FourierTrajectory,
-    robot: Robot,
-    model: Robot,
-    torque: NDArray | None,
-    space: KeepOut | None,
-    low: NDArray,
-    high: NDArray,
-    at_rest: bool,
-) -> FourierTrajectory:
-    """The random start redrawn (up to START_DRAWS times) until gravity at q0 takes at most half
-    of each torque limit, leaving the other half to the motion, and the arm standing at q0 is
-    outside the keep-out by twice its margin; else the draw needing least."""
-    best, best_load = start, np.inf
-    for _ in range(START_DRAWS):
-        load = 0.0
-        if torque is not None:
-            load = float(np.max(np.abs(model.gravity(start.q0)) / torque)) / 0.5
-        if space is not None:
-            values = _keep_out_at(robot, space, start.q0, start.q0)
-            room = float(values.min(initial=np.inf)) / (2 * space.margin + 1e-12)
-            load = max(load, 2.0 - min(room, 2.0))  # 1 when the room is exactly twice the margin
-        if load < best_load:
-            best, best_load = start, load
-        if load <= 1.0:
-            break
-        start = _random_start(
-            rng, start.n, start.harmonics, start.base_frequency, low, high, at_rest
-        )
-    return best
-
-
-def _keep_out_at(robot: Robot, space: KeepOut, q: NDArray, q_ref: NDArray) -> NDArray:
-    radii, pairs = capsule_pairs(robot, space, q_ref)
-    return constraint_values(robot, space, radii, pairs, np.atleast_2d(q))[0][0]
-
-
-class _NonlinearLimits:
-    """The torque and keep-out limits over the whole period, and the largest amplitude factor
-    (about q0) that meets them."""
-
-    def __init__(
-        self,
-        robot: Robot,
-        model: Robot,
-        torque: NDArray | None,
-        space: KeepOut | None,
-        q_ref: NDArray,
-        samples: int,
-    ) -> None:
-        self.robot, self.model, self.torque, self.space = robot, model, torque, space
-        self.q_ref, self.samples = q_ref, samples
-
-    def holds(self, trajectory: FourierTrajectory) -> bool:
-        if self.torque is not None and np.any(
-            torque_extents(self.model, trajectory, self.samples) > self.torque
-        ):
-            return False
-        return self.space is None or keep_out_holds(
-            self.robot, self.space, trajectory, self.samples, self.q_ref
-        )
-
-    def scale(self, trajectory: FourierTrajectory) -> float:
-        """1.0 if ``trajectory`` holds, else the largest factor found by bisection (to 1e-6) whose
-        scaled trajectory holds; ValueError when even standing at q0 does not (factor 0)."""
-        if self.holds(trajectory):
-            return 1.0
-        q0 = trajectory.q0
-        if self.torque is not None:
-            at_rest = np.abs(self.model.gravity(q0))
-            if np.any(at_rest > self.torque):
-                joint = int(np.argmax(at_rest - self.torque))
-                raise ValueError(
-                    f"tau_max: the gravity torque at the mean position q0 alone "
-                    f"({at_rest[joint]:.4g}) exceeds the limit of joint {joint + 1} "
-                    f"({self.torque[joint]:.4g}): no amplitude helps"
-                )
-        if self.space is not None:
-            values = _keep_out_at(self.robot, self.space, q0, self.q_ref)
-            if np.any(values < 0):
-                _, pairs = capsule_pairs(self.robot, self.space, self.q_ref)
-                label = constraint_labels(self.robot.n, self.space, pairs)[int(np.argmin(values))]
-                raise ValueError(
-                    f"keep_out: the arm standing at the mean position q0 violates it ({label}, "
-                    f"by {-values.min():.4g} m): no amplitude helps"
-                )
-        low, high = 0.0, 1.0  # low always holds (0: standing still at q0)
-        while high - low > 1e-6:
-            middle = 0.5 * (low + high)
-            low, high = (middle, high) if self.holds(_scaled(trajectory, middle)) else (low, middle)
-        return low
 
 
 def _check_initial(

@@ -35,7 +35,8 @@ if TYPE_CHECKING:
     from ..model.robot import Robot
 
 #: Fraction of each torque limit kept free on the optimiser's grid: room for the excursion
-#: between its points, so that the final scaling (torque_scale) rarely has to shrink anything.
+#: between its points, so that the final scaling (limit_scaling.NonlinearLimits) rarely has to
+#: shrink anything.
 TORQUE_MARGIN = 0.02
 
 #: |tau''| between grid points is taken as at most this times its largest value on the grid. On
@@ -144,35 +145,6 @@ def torque_extents(model: Robot, trajectory: FourierTrajectory, samples: int) ->
         neighbours(np.abs(smooth)) + coulomb_max,
     )
     return np.asarray(bound.max(axis=0) + curvature, dtype=np.float64)
-
-
-def torque_scale(
-    model: Robot, trajectory: FourierTrajectory, tau_max: NDArray, samples: int
-) -> float:
-    """The largest factor f <= 1 (found by bisection to 1e-6) such that the amplitudes scaled by
-    f about q0 keep :func:`torque_extents` within ``tau_max``; 1.0 when they already are.
-    ValueError naming ``tau_max`` when even standing at q0 needs more (f = 0: gravity)."""
-    if np.all(torque_extents(model, trajectory, samples) <= tau_max):
-        return 1.0
-    at_rest = np.abs(model.gravity(trajectory.q0))
-    if np.any(at_rest > tau_max):
-        joint = int(np.argmax(at_rest - tau_max))
-        raise ValueError(
-            f"tau_max: the gravity torque at the mean position q0 alone ({at_rest[joint]:.4g}) "
-            f"exceeds the limit of joint {joint + 1} ({tau_max[joint]:.4g}): no amplitude helps"
-        )
-    low, high = 0.0, 1.0  # low always certified (0: standing still at q0)
-    while high - low > 1e-6:
-        middle = 0.5 * (low + high)
-        within = torque_extents(model, _scaled(trajectory, middle), samples) <= tau_max
-        low, high = (middle, high) if np.all(within) else (low, middle)
-    return low
-
-
-def _scaled(trajectory: FourierTrajectory, factor: float) -> FourierTrajectory:
-    return FourierTrajectory(
-        trajectory.base_frequency, factor * trajectory.a, factor * trajectory.b, trajectory.q0
-    )
 
 
 def _jerk_and_snap(trajectory: FourierTrajectory, t: NDArray) -> tuple[NDArray, NDArray]:
