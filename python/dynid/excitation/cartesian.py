@@ -161,6 +161,7 @@ class KeepOutConstraint:
         c = np.hstack([x[: n * H].reshape(n, H), x[n * H : 2 * n * H].reshape(n, H)])
         q = self.Bq @ c.T + x[2 * n * H :]
         value, dq = constraint_values(self.robot, self.keep_out, self.radii, self.pairs, q, True)
+        assert dq is not None  # asked for (derivatives=True)
         T, rows = value.shape
         Bq = self.Bq
         # dq_i(t)/da_il = Bq[t, l], dq_i(t)/db_il = Bq[t, H + l], dq_i(t)/dq0_i = 1
