@@ -579,7 +579,17 @@ def _joint_values(values: list[float], n: int, option: str) -> Any:
 
 
 def _urdf_limits(model: Any, robot: Any) -> tuple[Any, Any]:
-    """A URDF model's <limit velocity effort> (NaN where not given), else (None, None)."""
+    """The model's velocity and effort limits, NaN where not known; (None, None) for none.
+
+    A robot with the fields ``velocity_limits``/``effort_limits`` (inf: not known; issue 21,
+    item 3, read from a URDF's <limit>, kept in model files, the Panda's built in) gives them;
+    one without them (a dynid before those fields) has them read from a URDF model's <limit>."""
+    import numpy as np
+
+    fields = getattr(robot, "velocity_limits", None), getattr(robot, "effort_limits", None)
+    if fields[0] is not None and fields[1] is not None:
+        velocity, effort = (np.where(np.isinf(f), np.nan, np.asarray(f, float)) for f in fields)
+        return velocity, effort
     if not str(model).lower().endswith(".urdf"):
         return None, None
     from ..excitation.joint_limits import urdf_velocity_effort
@@ -602,8 +612,8 @@ def _limit_option(given: Any, from_urdf: Any, default: float | None, n: int, opt
     if default is None and np.any(np.isnan(from_urdf)):
         missing = [j + 1 for j in np.flatnonzero(np.isnan(from_urdf))]
         raise ValueError(
-            f"{option}: the URDF gives no (or a zero) effort limit for joint(s) {missing}; give "
-            "the limits with --tau-max"
+            f"{option}: the model gives no effort limit for joint(s) {missing} (a URDF's "
+            "<limit effort> missing or 0); give the limits with --tau-max"
         )
     return np.where(np.isnan(from_urdf), default if default is not None else np.nan, from_urdf)
 

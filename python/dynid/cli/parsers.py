@@ -253,7 +253,8 @@ def _add_excite(subcommands: Any) -> None:
         "--qd-max",
         type=_per_joint,
         metavar="QD",
-        help="velocity limits [rad/s] (default a URDF's <limit velocity>, else 1.0)",
+        help="velocity limits [rad/s] (default the model's, e.g. a URDF's <limit velocity>, "
+        "else 1.0)",
     )
     p.add_argument(
         "--qdd-max",
@@ -265,7 +266,7 @@ def _add_excite(subcommands: Any) -> None:
         "--tau-max",
         type=_per_joint,
         metavar="TAU",
-        help="torque limits [N m] (default a URDF's <limit effort>, else none)",
+        help="torque limits [N m] (default the model's, e.g. a URDF's <limit effort>, else none)",
     )
     p.add_argument(
         "--position-margin",
