@@ -586,10 +586,13 @@ def _urdf_limits(model: Any, robot: Any) -> tuple[Any, Any]:
     one without them (a dynid before those fields) has them read from a URDF model's <limit>."""
     import numpy as np
 
-    fields = getattr(robot, "velocity_limits", None), getattr(robot, "effort_limits", None)
-    if fields[0] is not None and fields[1] is not None:
-        velocity, effort = (np.where(np.isinf(f), np.nan, np.asarray(f, float)) for f in fields)
-        return velocity, effort
+    velocity, effort = (
+        getattr(robot, "velocity_limits", None),
+        getattr(robot, "effort_limits", None),
+    )
+    if velocity is not None and effort is not None:
+        v, e = np.asarray(velocity, dtype=float), np.asarray(effort, dtype=float)
+        return np.where(np.isinf(v), np.nan, v), np.where(np.isinf(e), np.nan, e)
     if not str(model).lower().endswith(".urdf"):
         return None, None
     from ..excitation.joint_limits import urdf_velocity_effort
