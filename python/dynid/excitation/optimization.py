@@ -10,6 +10,7 @@ inequalities; only the objective is nonlinear. SLSQP minimises it with the analy
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,6 +21,9 @@ from scipy.optimize import minimize
 from .._threads import blas_single_threaded
 from ..model.base_parameters import BaseParameters, base_parameters
 from ..model.robot import Robot
+from .cartesian import KeepOut, KeepOutConstraint
+from .limit_scaling import NonlinearLimits, start_with_room
+from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_limit_vector
 from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,
@@ -85,6 +89,10 @@ def optimize_excitation(
     maxiter: int = 200,
     initial: FourierTrajectory | None = None,
     position_margin: float = DEFAULT_POSITION_MARGIN,
+    tau_max: ArrayLike | None = None,
+    torque_model: Robot | None = None,
+    keep_out: KeepOut | None = None,
+    progress: Callable[[int, float], None] | None = None,
 ) -> ExcitationResult:
     """Fourier coefficients and offsets minimising the condition number of the base regressor.
 
@@ -96,6 +104,17 @@ def optimize_excitation(
     random trajectory drawn with ``seed``, scaled to the limits. The result is afterwards checked
     on a grid CHECK_OVERSAMPLING times denser, with a bound on the excursion between its points,
     and its amplitudes shrunk about q0 if needed, so it meets every limit over the whole period.
+
+    ``tau_max`` (a scalar or (n,), None: no torque limit) adds |tau| <= tau_max, the torque of
+    ``torque_model`` (default ``robot``; e.g. a prior model with the drive terms) by rnea along
+    the motion: SLSQP sees it on the constraint points with TORQUE_MARGIN kept free, and the
+    start and the result are shrunk about q0 until the bound of
+    :func:`dynid.excitation.torque_limits.torque_extents` holds over the whole period.
+    ``keep_out`` (:class:`dynid.excitation.cartesian.KeepOut`) keeps the link origins and the
+    tool point above a floor and inside a box, and non-adjacent links (capsules) apart: SLSQP
+    sees them on the constraint points with ``keep_out.margin`` free, and the start and the result
+    are shrunk about q0 until they hold over the whole period (cartesian.keep_out_holds).
+    ``progress(iteration, cond)`` is called after each SLSQP iteration.
     """
     n = robot.n
     harmonics = _integer(harmonics, "harmonics", minimum=2 if at_rest else 1)
@@ -119,20 +138,47 @@ def optimize_excitation(
     low, high = robot.qlim[:, 0] + margin * span, robot.qlim[:, 1] - margin * span
     wf = 2.0 * np.pi / period
     limits = (np.column_stack([low, high]), vel, acc)
+    torque = None if tau_max is None else torque_limit_vector(tau_max, n)
+    model = robot if torque_model is None else torque_model
+    if torque is not None and (not isinstance(model, Robot) or model.n != n):
+        raise ValueError(f"torque_model: expected a Robot with {n} joints, got {model!r}")
+    if keep_out is not None and not isinstance(keep_out, KeepOut):
+        raise ValueError(f"keep_out: expected a KeepOut, got {type(keep_out).__name__}")
+    space = keep_out if keep_out is not None and keep_out.active else None
+    check = CHECK_OVERSAMPLING * samples
 
     if initial is None:
-        start = _random_start(np.random.default_rng(seed), n, harmonics, wf, low, high, at_rest)
+        rng = np.random.default_rng(seed)
+        start = _random_start(rng, n, harmonics, wf, low, high, at_rest)
+        if torque is not None or space is not None:
+
+            def redraw() -> FourierTrajectory:
+                return _random_start(rng, n, harmonics, wf, low, high, at_rest)
+
+            start = start_with_room(start, redraw, robot, model, torque, space)
     else:
         start = _check_initial(initial, n, harmonics, period, low, high, at_rest)
-    scale = _limit_scale(start, *limits, CHECK_OVERSAMPLING * samples)
+    scale = _limit_scale(start, *limits, check)
     # a random start is stretched to touch the nearest limit, a given one only shrunk if needed
     start = _scaled(start, scale if initial is None else min(scale, 1.0))
+    q_ref = start.q0  # the configuration the capsules' segment lengths are measured at
+    nonlinear = NonlinearLimits(robot, model, torque, space, q_ref, check)
+    # then shrunk until its torque and keep-out limits hold everywhere
+    start = _scaled(start, nonlinear.scale(start))
 
     t = period * np.arange(samples) / samples
     objective = _LogCondition(robot, base, t, wf, harmonics, rotor, friction)
     m = min(samples, CONSTRAINT_POINTS_PER_HARMONIC * harmonics)
     grid = _basis(period * np.arange(m) / m, wf, harmonics)
     constraints: list[Any] = [_inequalities(grid, n, low, high, vel, acc)]  # SciPy's dicts
+    points = period * np.arange(m) / m
+    if torque is not None:
+        limit = (1.0 - TORQUE_MARGIN) * torque
+        constraints.append(TorqueConstraint(model, points, wf, harmonics, limit).as_dict())
+    if space is not None:
+        # the Cartesian motion needs a finer grid than the joints' 20 H: samples points
+        keep_t = period * np.arange(samples) / samples
+        constraints.append(KeepOutConstraint(robot, space, keep_t, wf, harmonics, q_ref).as_dict())
     if at_rest:
         constraints.append(_rest_equalities(n, harmonics))
     x0 = start.to_vector()
@@ -144,6 +190,7 @@ def optimize_excitation(
             method="SLSQP",
             constraints=constraints,
             options={"maxiter": maxiter, "ftol": TOLERANCE},
+            callback=None if progress is None else _Progress(progress, objective),
         )
         x, iterations, success, message = (
             result.x,
@@ -160,7 +207,9 @@ def optimize_excitation(
     # q0 is the mean of q over the constraint points, so inside the limits unless SLSQP stopped
     # infeasible; clipping keeps the scaling below well defined in that case too.
     final = FourierTrajectory(wf, final.a, final.b, np.clip(final.q0, low, high))
-    scale = _limit_scale(final, *limits, CHECK_OVERSAMPLING * samples)
+    scale = _limit_scale(final, *limits, check)
+    if torque is not None or space is not None:
+        scale = min(scale, 1.0) * nonlinear.scale(_scaled(final, min(scale, 1.0)))
     if scale < 1.0:
         final = _scaled(final, scale)
         message += f"; amplitudes scaled by {scale:.6f} to meet the limits between samples"
@@ -171,6 +220,17 @@ def optimize_excitation(
         final, after, success = start, before, False
         message += "; no improvement on the initial guess, which is returned"
     return ExcitationResult(final, before, after, iterations, success, message, start)
+
+
+class _Progress:
+    """SLSQP's callback: ``report(iteration, cond)`` after each iteration."""
+
+    def __init__(self, report: Callable[[int, float], None], objective: _LogCondition) -> None:
+        self.report, self.objective, self.iteration = report, objective, 0
+
+    def __call__(self, x: NDArray[np.float64]) -> None:
+        self.iteration += 1
+        self.report(self.iteration, float(np.exp(self.objective.value(x))))
 
 
 # ---- the objective ----------------------------------------------------------------------------
