@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from collections.abc import Callable
 from typing import Any
@@ -483,6 +484,149 @@ def residual(args: argparse.Namespace) -> None:
     for j, (rms, largest) in enumerate(zip(result.rms, result.max_abs)):
         print(f"  J{j + 1:<5}{rms:>11.4g}{largest:>16.4g}")
     print(f"wrote {args.output}/residual.npz, {args.output}/residual.png", flush=True)
+
+
+def excite(args: argparse.Namespace) -> None:
+    """``dynid excite``: optimise the experiment's trajectory and write its files."""
+    import numpy as np
+
+    from ..excitation.experiment import design_experiment
+    from ..export.output_folder import check_output_path
+    from ..export.trajectory_out import save_trajectory_folder
+
+    inputs = [args.model, args.prior]
+    check_output_path(args.output, args.overwrite, inputs=inputs)
+    check_links(args, args.model, args.prior)
+    for option, rate in (("--rate", args.rate), ("--ros-rate", args.ros_rate)):
+        if not (np.isfinite(rate) and rate > 0):  # checked before the optimisation, not after
+            raise ValueError(f"{option}: expected a positive rate [Hz], got {rate:g}")
+    robot = load_robot(args, args.model).copy()
+    prior = None if args.prior is None else load_robot(args, args.prior)
+    if prior is not None and prior.n != robot.n:
+        raise ValueError(f"--prior: expected a model with {robot.n} joints, got {prior.n}")
+    qlim = robot.qlim.copy()
+    for column, given, option in ((0, args.q_min, "--q-min"), (1, args.q_max, "--q-max")):
+        if given is not None:
+            qlim[:, column] = _joint_values(given, robot.n, option)
+    if np.any(qlim[:, 0] >= qlim[:, 1]):
+        raise ValueError("--q-min, --q-max: expected each lower limit below its upper limit")
+    robot.qlim = qlim
+    urdf_velocity, urdf_effort = _urdf_limits(args.model, robot)
+    qd_max = _limit_option(args.qd_max, urdf_velocity, 1.0, robot.n, "--qd-max")
+    qdd_max = _limit_option(args.qdd_max, None, 2.0, robot.n, "--qdd-max")
+    tau_max = _limit_option(args.tau_max, urdf_effort, None, robot.n, "--tau-max")
+    keep_out = _keep_out(args)
+    start = time.perf_counter()
+    last = [start]
+
+    def progress(iteration: int, cond: float) -> None:
+        now = time.perf_counter()
+        if now - last[0] >= 2.0:  # a line every 2 s at most, on stderr (stdout: the summary)
+            last[0] = now
+            print(
+                f"dynid excite: iteration {iteration}, cond {cond:.4g} ({now - start:.1f} s)",
+                file=sys.stderr,
+                flush=True,
+            )
+
+    plan, result = design_experiment(
+        robot,
+        qd_max=qd_max,
+        qdd_max=qdd_max,
+        tau_max=tau_max,
+        torque_model=prior,
+        harmonics=args.harmonics,
+        period=args.period,
+        periods=args.periods,
+        samples=args.samples,
+        position_margin=args.position_margin,
+        rotor=args.rotor,
+        friction=args.friction,
+        seed=args.seed,
+        maxiter=args.maxiter,
+        keep_out=keep_out,
+        progress=progress,
+    )
+    save_trajectory_folder(
+        plan,
+        robot if prior is None else prior,
+        args.output,
+        rate=args.rate,
+        ros_rate=args.ros_rate,
+        overwrite=args.overwrite,
+        inputs=inputs,
+    )
+    print(
+        f"{robot.name}: cond {result.condition_before:.4g} -> {result.condition_after:.4g} "
+        f"in {result.iterations} iterations ({time.perf_counter() - start:.1f} s); "
+        f"{result.message}"
+    )
+    print(
+        f"{plan.periods} period(s) of {plan.trajectory.period:g} s, {plan.trajectory.harmonics} "
+        f"harmonics, starting and ending at rest at q(0)"
+    )
+    print(
+        f"wrote {args.output}/trajectory.json, trajectory.csv ({args.rate:g} Hz), "
+        f"trajectory_ros.yaml ({args.ros_rate:g} Hz), trajectory.hpp",
+        flush=True,
+    )
+
+
+def _keep_out(args: argparse.Namespace) -> Any:
+    """--floor, --box, --capsule-radius, --keep-out-margin as a KeepOut (None without any)."""
+    if args.floor is None and args.box is None and args.capsule_radius is None:
+        return None
+    from ..excitation.cartesian import KeepOut
+
+    options = {"floor": "--floor", "box": "--box", "radii": "--capsule-radius"}
+    try:
+        return KeepOut(
+            floor=args.floor,
+            box=None if args.box is None else tuple(args.box),
+            radii=None if args.capsule_radius is None else args.capsule_radius,
+            margin=args.keep_out_margin,
+        )
+    except ValueError as exc:  # name the option, not the field
+        field, _, rest = str(exc).partition(":")
+        raise ValueError(f"{options.get(field, '--keep-out-margin')}:{rest}") from None
+
+
+def _joint_values(values: list[float], n: int, option: str) -> Any:
+    import numpy as np
+
+    if len(values) not in (1, n):
+        raise ValueError(f"{option}: expected one number or {n} (one per joint), got {len(values)}")
+    return np.broadcast_to(np.asarray(values, dtype=float), (n,)).copy()
+
+
+def _urdf_limits(model: Any, robot: Any) -> tuple[Any, Any]:
+    """A URDF model's <limit velocity effort> (NaN where not given), else (None, None)."""
+    if not str(model).lower().endswith(".urdf"):
+        return None, None
+    from ..excitation.joint_limits import urdf_velocity_effort
+
+    return urdf_velocity_effort(model, robot.joint_names)
+
+
+def _limit_option(given: Any, from_urdf: Any, default: float | None, n: int, option: str) -> Any:
+    """The option if given, else the URDF's values (the default where it has none), else the
+    default (None: no limit)."""
+    import numpy as np
+
+    if given is not None:
+        values = _joint_values(given, n, option)
+        if not np.all(np.isfinite(values) & (values > 0)):
+            raise ValueError(f"{option}: expected positive limits, got {given}")
+        return values
+    if from_urdf is None or np.all(np.isnan(from_urdf)):
+        return default
+    if default is None and np.any(np.isnan(from_urdf)):
+        missing = [j + 1 for j in np.flatnonzero(np.isnan(from_urdf))]
+        raise ValueError(
+            f"{option}: the URDF gives no (or a zero) effort limit for joint(s) {missing}; give "
+            "the limits with --tau-max"
+        )
+    return np.where(np.isnan(from_urdf), default if default is not None else np.nan, from_urdf)
 
 
 def info(args: argparse.Namespace) -> None:

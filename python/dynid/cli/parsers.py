@@ -30,6 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_info(subcommands)
     _add_export(subcommands)
     _add_residual(subcommands)
+    _add_excite(subcommands)
     # Each command knows its own parser, so that an option it does not have is reported with the
     # command's usage, not the top level's (main()).
     for command in subcommands.choices.values():
@@ -214,6 +215,124 @@ def _add_residual(subcommands: Any) -> None:
     _add_links(p)
     _add_output(p, "dynid-residual")
     p.set_defaults(run=commands.residual)
+
+
+def _per_joint(text: str) -> list[float]:
+    """A per-joint option: one number for every joint, or one per joint separated by commas."""
+    try:
+        return [float(item) for item in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a number or comma-separated numbers, one per joint, got {text!r}"
+        ) from None
+
+
+def _add_excite(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "excite",
+        help="design an exciting trajectory for identification (docs/excitation.md)",
+        description="Optimise a rest-to-rest Fourier trajectory minimising the condition number "
+        "of the base regressor within position, velocity, acceleration and torque limits; write "
+        "trajectory.json, trajectory.csv, trajectory_ros.yaml and trajectory.hpp into DIR. "
+        "Per-joint limits take one number for all joints or one per joint, comma-separated "
+        "(negative numbers as --q-min=-1,-2).",
+    )
+    _add_model(p)
+    _add_links(p)
+    p.add_argument(
+        "--prior",
+        metavar="MODEL|URDF",
+        help="the model whose torque is limited and written to the CSV (built-in name, model "
+        "file or URDF of the same arm; default --model)",
+    )
+    p.add_argument(
+        "--q-min", type=_per_joint, metavar="Q", help="lower joint limits (default the model's)"
+    )
+    p.add_argument(
+        "--q-max", type=_per_joint, metavar="Q", help="upper joint limits (default the model's)"
+    )
+    p.add_argument(
+        "--qd-max",
+        type=_per_joint,
+        metavar="QD",
+        help="velocity limits [rad/s] (default a URDF's <limit velocity>, else 1.0)",
+    )
+    p.add_argument(
+        "--qdd-max",
+        type=_per_joint,
+        metavar="QDD",
+        help="acceleration limits [rad/s^2] (default 2.0)",
+    )
+    p.add_argument(
+        "--tau-max",
+        type=_per_joint,
+        metavar="TAU",
+        help="torque limits [N m] (default a URDF's <limit effort>, else none)",
+    )
+    p.add_argument(
+        "--position-margin",
+        type=float,
+        default=0.02,
+        metavar="F",
+        help="distance kept from each position limit, a fraction of the range (default 0.02)",
+    )
+    p.add_argument("--harmonics", type=int, default=5, help="Fourier harmonics (default 5)")
+    p.add_argument(
+        "--period", type=float, default=10.0, metavar="S", help="period [s] (default 10)"
+    )
+    p.add_argument("--periods", type=int, default=1, metavar="N", help="periods played (default 1)")
+    p.add_argument(
+        "--samples", type=int, default=200, help="samples per period of the objective (default 200)"
+    )
+    p.add_argument(
+        "--rate",
+        type=float,
+        default=1000.0,
+        metavar="HZ",
+        help="controller rate of the CSV (default 1000)",
+    )
+    p.add_argument(
+        "--ros-rate",
+        type=float,
+        default=100.0,
+        metavar="HZ",
+        help="points per second of trajectory_ros.yaml (default 100; controllers interpolate)",
+    )
+    p.add_argument(
+        "--floor",
+        type=float,
+        metavar="Z",
+        help="keep the link origins and the tool point above the plane z = Z [m, world frame]",
+    )
+    p.add_argument(
+        "--box",
+        type=float,
+        nargs=6,
+        metavar=("XMIN", "XMAX", "YMIN", "YMAX", "ZMIN", "ZMAX"),
+        help="keep the link origins and the tool point inside this box [m, world frame]",
+    )
+    p.add_argument(
+        "--capsule-radius",
+        type=_per_joint,
+        metavar="R",
+        help="keep non-adjacent links apart, each a capsule of this radius [m] about the segment "
+        "between consecutive DH frame origins (n + 1 segments, the last to the tool point; one "
+        "radius or n + 1)",
+    )
+    p.add_argument(
+        "--keep-out-margin",
+        type=float,
+        default=0.05,
+        metavar="M",
+        help="free distance [m] the optimiser keeps from the floor, box and capsules on its "
+        "grid (default 0.05)",
+    )
+    p.add_argument("--rotor", action="store_true", help="excite the rotor inertia columns too")
+    p.add_argument("--friction", action="store_true", help="excite the friction columns too")
+    p.add_argument("--seed", type=int, default=0, help="random start (default 0)")
+    p.add_argument("--maxiter", type=int, default=200, help="SLSQP iterations (default 200)")
+    _add_output(p, "dynid-excite")
+    p.set_defaults(run=commands.excite)
 
 
 def _add_current(p: argparse.ArgumentParser) -> None:

@@ -10,6 +10,7 @@ inequalities; only the objective is nonlinear. SLSQP minimises it with the analy
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,6 +21,15 @@ from scipy.optimize import minimize
 from .._threads import blas_single_threaded
 from ..model.base_parameters import BaseParameters, base_parameters
 from ..model.robot import Robot
+from .cartesian import (
+    KeepOut,
+    KeepOutConstraint,
+    capsule_pairs,
+    constraint_labels,
+    constraint_values,
+    keep_out_holds,
+)
+from .torque_limits import TORQUE_MARGIN, TorqueConstraint, torque_extents, torque_limit_vector
 from .trajectory import (
     DEFAULT_QD_MAX,
     DEFAULT_QDD_MAX,
@@ -51,6 +61,10 @@ TOLERANCE = 1e-4
 
 #: The returned trajectory is checked on a grid this many times denser than ``samples``.
 CHECK_OVERSAMPLING = 10
+
+#: With torque limits, random starts drawn at most this many times to find a mean position q0
+#: where gravity leaves room for the motion (_start_within_gravity).
+START_DRAWS = 100
 
 # Central-difference step in q for the regressor's derivative (error ~h^2, rounding ~1e-16/h).
 _Q_STEP = 1e-5
@@ -85,6 +99,10 @@ def optimize_excitation(
     maxiter: int = 200,
     initial: FourierTrajectory | None = None,
     position_margin: float = DEFAULT_POSITION_MARGIN,
+    tau_max: ArrayLike | None = None,
+    torque_model: Robot | None = None,
+    keep_out: KeepOut | None = None,
+    progress: Callable[[int, float], None] | None = None,
 ) -> ExcitationResult:
     """Fourier coefficients and offsets minimising the condition number of the base regressor.
 
@@ -96,6 +114,17 @@ def optimize_excitation(
     random trajectory drawn with ``seed``, scaled to the limits. The result is afterwards checked
     on a grid CHECK_OVERSAMPLING times denser, with a bound on the excursion between its points,
     and its amplitudes shrunk about q0 if needed, so it meets every limit over the whole period.
+
+    ``tau_max`` (a scalar or (n,), None: no torque limit) adds |tau| <= tau_max, the torque of
+    ``torque_model`` (default ``robot``; e.g. a prior model with the drive terms) by rnea along
+    the motion: SLSQP sees it on the constraint points with TORQUE_MARGIN kept free, and the
+    start and the result are shrunk about q0 until the bound of
+    :func:`dynid.excitation.torque_limits.torque_extents` holds over the whole period.
+    ``keep_out`` (:class:`dynid.excitation.cartesian.KeepOut`) keeps the link origins and the
+    tool point above a floor and inside a box, and non-adjacent links (capsules) apart: SLSQP
+    sees them on the constraint points with ``keep_out.margin`` free, and the start and the result
+    are shrunk about q0 until they hold over the whole period (cartesian.keep_out_holds).
+    ``progress(iteration, cond)`` is called after each SLSQP iteration.
     """
     n = robot.n
     harmonics = _integer(harmonics, "harmonics", minimum=2 if at_rest else 1)
@@ -119,20 +148,43 @@ def optimize_excitation(
     low, high = robot.qlim[:, 0] + margin * span, robot.qlim[:, 1] - margin * span
     wf = 2.0 * np.pi / period
     limits = (np.column_stack([low, high]), vel, acc)
+    torque = None if tau_max is None else torque_limit_vector(tau_max, n)
+    model = robot if torque_model is None else torque_model
+    if torque is not None and (not isinstance(model, Robot) or model.n != n):
+        raise ValueError(f"torque_model: expected a Robot with {n} joints, got {model!r}")
+    if keep_out is not None and not isinstance(keep_out, KeepOut):
+        raise ValueError(f"keep_out: expected a KeepOut, got {type(keep_out).__name__}")
+    space = keep_out if keep_out is not None and keep_out.active else None
+    check = CHECK_OVERSAMPLING * samples
 
     if initial is None:
-        start = _random_start(np.random.default_rng(seed), n, harmonics, wf, low, high, at_rest)
+        rng = np.random.default_rng(seed)
+        start = _random_start(rng, n, harmonics, wf, low, high, at_rest)
+        if torque is not None or space is not None:
+            start = _start_with_room(rng, start, robot, model, torque, space, low, high, at_rest)
     else:
         start = _check_initial(initial, n, harmonics, period, low, high, at_rest)
-    scale = _limit_scale(start, *limits, CHECK_OVERSAMPLING * samples)
+    scale = _limit_scale(start, *limits, check)
     # a random start is stretched to touch the nearest limit, a given one only shrunk if needed
     start = _scaled(start, scale if initial is None else min(scale, 1.0))
+    q_ref = start.q0  # the configuration the capsules' segment lengths are measured at
+    nonlinear = _NonlinearLimits(robot, model, torque, space, q_ref, check)
+    # then shrunk until its torque and keep-out limits hold everywhere
+    start = _scaled(start, nonlinear.scale(start))
 
     t = period * np.arange(samples) / samples
     objective = _LogCondition(robot, base, t, wf, harmonics, rotor, friction)
     m = min(samples, CONSTRAINT_POINTS_PER_HARMONIC * harmonics)
     grid = _basis(period * np.arange(m) / m, wf, harmonics)
     constraints: list[Any] = [_inequalities(grid, n, low, high, vel, acc)]  # SciPy's dicts
+    points = period * np.arange(m) / m
+    if torque is not None:
+        limit = (1.0 - TORQUE_MARGIN) * torque
+        constraints.append(TorqueConstraint(model, points, wf, harmonics, limit).as_dict())
+    if space is not None:
+        # the Cartesian motion needs a finer grid than the joints' 20 H: samples points
+        keep_t = period * np.arange(samples) / samples
+        constraints.append(KeepOutConstraint(robot, space, keep_t, wf, harmonics, q_ref).as_dict())
     if at_rest:
         constraints.append(_rest_equalities(n, harmonics))
     x0 = start.to_vector()
@@ -144,6 +196,7 @@ def optimize_excitation(
             method="SLSQP",
             constraints=constraints,
             options={"maxiter": maxiter, "ftol": TOLERANCE},
+            callback=None if progress is None else _Progress(progress, objective),
         )
         x, iterations, success, message = (
             result.x,
@@ -160,7 +213,9 @@ def optimize_excitation(
     # q0 is the mean of q over the constraint points, so inside the limits unless SLSQP stopped
     # infeasible; clipping keeps the scaling below well defined in that case too.
     final = FourierTrajectory(wf, final.a, final.b, np.clip(final.q0, low, high))
-    scale = _limit_scale(final, *limits, CHECK_OVERSAMPLING * samples)
+    scale = _limit_scale(final, *limits, check)
+    if torque is not None or space is not None:
+        scale = min(scale, 1.0) * nonlinear.scale(_scaled(final, min(scale, 1.0)))
     if scale < 1.0:
         final = _scaled(final, scale)
         message += f"; amplitudes scaled by {scale:.6f} to meet the limits between samples"
@@ -171,6 +226,17 @@ def optimize_excitation(
         final, after, success = start, before, False
         message += "; no improvement on the initial guess, which is returned"
     return ExcitationResult(final, before, after, iterations, success, message, start)
+
+
+class _Progress:
+    """SLSQP's callback: ``report(iteration, cond)`` after each iteration."""
+
+    def __init__(self, report: Callable[[int, float], None], objective: _LogCondition) -> None:
+        self.report, self.objective, self.iteration = report, objective, 0
+
+    def __call__(self, x: NDArray[np.float64]) -> None:
+        self.iteration += 1
+        self.report(self.iteration, float(np.exp(self.objective.value(x))))
 
 
 # ---- the objective ----------------------------------------------------------------------------
@@ -333,6 +399,100 @@ def _random_start(
         a, b = _rest_projection(a, b)
     q0 = low + (high - low) * rng.uniform(0.25, 0.75, n)
     return FourierTrajectory(wf, a, b, q0)
+
+
+def _start_with_room(
+    rng: np.random.Generator,
+    start: FourierTrajectory,
+    robot: Robot,
+    model: Robot,
+    torque: NDArray | None,
+    space: KeepOut | None,
+    low: NDArray,
+    high: NDArray,
+    at_rest: bool,
+) -> FourierTrajectory:
+    """The random start redrawn (up to START_DRAWS times) until gravity at q0 takes at most half
+    of each torque limit, leaving the other half to the motion, and the arm standing at q0 is
+    outside the keep-out by twice its margin; else the draw needing least."""
+    best, best_load = start, np.inf
+    for _ in range(START_DRAWS):
+        load = 0.0
+        if torque is not None:
+            load = float(np.max(np.abs(model.gravity(start.q0)) / torque)) / 0.5
+        if space is not None:
+            values = _keep_out_at(robot, space, start.q0, start.q0)
+            room = float(values.min(initial=np.inf)) / (2 * space.margin + 1e-12)
+            load = max(load, 2.0 - min(room, 2.0))  # 1 when the room is exactly twice the margin
+        if load < best_load:
+            best, best_load = start, load
+        if load <= 1.0:
+            break
+        start = _random_start(
+            rng, start.n, start.harmonics, start.base_frequency, low, high, at_rest
+        )
+    return best
+
+
+def _keep_out_at(robot: Robot, space: KeepOut, q: NDArray, q_ref: NDArray) -> NDArray:
+    radii, pairs = capsule_pairs(robot, space, q_ref)
+    return constraint_values(robot, space, radii, pairs, np.atleast_2d(q))[0][0]
+
+
+class _NonlinearLimits:
+    """The torque and keep-out limits over the whole period, and the largest amplitude factor
+    (about q0) that meets them."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        model: Robot,
+        torque: NDArray | None,
+        space: KeepOut | None,
+        q_ref: NDArray,
+        samples: int,
+    ) -> None:
+        self.robot, self.model, self.torque, self.space = robot, model, torque, space
+        self.q_ref, self.samples = q_ref, samples
+
+    def holds(self, trajectory: FourierTrajectory) -> bool:
+        if self.torque is not None and np.any(
+            torque_extents(self.model, trajectory, self.samples) > self.torque
+        ):
+            return False
+        return self.space is None or keep_out_holds(
+            self.robot, self.space, trajectory, self.samples, self.q_ref
+        )
+
+    def scale(self, trajectory: FourierTrajectory) -> float:
+        """1.0 if ``trajectory`` holds, else the largest factor found by bisection (to 1e-6) whose
+        scaled trajectory holds; ValueError when even standing at q0 does not (factor 0)."""
+        if self.holds(trajectory):
+            return 1.0
+        q0 = trajectory.q0
+        if self.torque is not None:
+            at_rest = np.abs(self.model.gravity(q0))
+            if np.any(at_rest > self.torque):
+                joint = int(np.argmax(at_rest - self.torque))
+                raise ValueError(
+                    f"tau_max: the gravity torque at the mean position q0 alone "
+                    f"({at_rest[joint]:.4g}) exceeds the limit of joint {joint + 1} "
+                    f"({self.torque[joint]:.4g}): no amplitude helps"
+                )
+        if self.space is not None:
+            values = _keep_out_at(self.robot, self.space, q0, self.q_ref)
+            if np.any(values < 0):
+                _, pairs = capsule_pairs(self.robot, self.space, self.q_ref)
+                label = constraint_labels(self.robot.n, self.space, pairs)[int(np.argmin(values))]
+                raise ValueError(
+                    f"keep_out: the arm standing at the mean position q0 violates it ({label}, "
+                    f"by {-values.min():.4g} m): no amplitude helps"
+                )
+        low, high = 0.0, 1.0  # low always holds (0: standing still at q0)
+        while high - low > 1e-6:
+            middle = 0.5 * (low + high)
+            low, high = (middle, high) if self.holds(_scaled(trajectory, middle)) else (low, middle)
+        return low
 
 
 def _check_initial(
