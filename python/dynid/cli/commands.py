@@ -494,6 +494,7 @@ def simulate(args: argparse.Namespace) -> None:
     from ..excitation.trajectory_files import load_trajectory
     from ..export.output_folder import check_output_path, output_folder
     from ..export.result_files import load_model_or_result
+    from ..identification.log_identification import LogIdentification
     from ..identification.realize import consistent_robot
     from ..logs.log_files import Log, save_log
     from ..logs.ros_bag_writer import write_ros_bag
@@ -503,7 +504,8 @@ def simulate(args: argparse.Namespace) -> None:
     check_output_path(args.output, args.overwrite, inputs=inputs)
     check_links(args, args.model)
     loaded = load_model_or_result(args.model, **model_links(args, args.model))
-    robot = loaded if not hasattr(loaded, "theta") else consistent_robot(loaded)
+    # A result: its robot (a least-squares one's closest physically consistent robot).
+    robot = consistent_robot(loaded) if isinstance(loaded, LogIdentification) else loaded
     plan = load_trajectory(args.trajectory)
     if plan.trajectory.n != robot.n:
         raise ValueError(
