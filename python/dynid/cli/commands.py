@@ -517,6 +517,85 @@ def residual(args: argparse.Namespace) -> None:
     print(f"wrote {args.output}/residual.npz, {args.output}/residual.png", flush=True)
 
 
+def simulate(args: argparse.Namespace) -> None:
+    """``dynid simulate``: rehearse an experiment and write the log its controller would record
+    (docs/workflow.md)."""
+    import json
+
+    from ..excitation.trajectory_files import load_trajectory
+    from ..export.output_folder import check_output_path, output_folder
+    from ..export.result_files import load_model_or_result
+    from ..identification.log_identification import LogIdentification
+    from ..identification.realize import consistent_robot
+    from ..logs.log_files import Log, save_log
+    from ..logs.ros_bag_writer import write_ros_bag
+    from ..sim.rehearsal import rehearse
+
+    inputs = [args.model, args.trajectory]
+    check_output_path(args.output, args.overwrite, inputs=inputs)
+    check_links(args, args.model)
+    loaded = load_model_or_result(args.model, **model_links(args, args.model))
+    # A result: its robot (a least-squares one's closest physically consistent robot).
+    robot = consistent_robot(loaded) if isinstance(loaded, LogIdentification) else loaded
+    plan = load_trajectory(args.trajectory)
+    if plan.trajectory.n != robot.n:
+        raise ValueError(
+            f"TRAJECTORY: {plan.trajectory.n} joints for a {robot.n}-joint MODEL ({robot.name})"
+        )
+    kp = None if args.kp is None else _joint_values(args.kp, robot.n, "--kp")
+    kd = None if args.kd is None else _joint_values(args.kd, robot.n, "--kd")
+    run = rehearse(
+        robot,
+        plan.evaluate,
+        plan.duration,
+        controller=args.controller,
+        kp=kp,
+        kd=kd,
+        bandwidth=args.bandwidth,
+        rate=args.rate,
+        friction=not args.no_friction,
+        torque_noise=args.torque_noise,
+        sensor_noise=args.sensor_noise,
+        encoder_counts=args.encoder_counts,
+        seed=args.seed,
+    )
+    notes = [
+        f"simulated by dynid simulate: {robot.name} tracking {args.trajectory} under "
+        f"{args.controller} at {args.rate:g} Hz"
+    ]
+    log = Log(
+        t=run.t,
+        q=run.q,
+        tau=run.tau,
+        qd=run.simulation.qd if args.velocities else None,
+        source=str(args.trajectory),
+        notes=notes,
+        format="dynid simulate",
+    )
+    settings = {
+        "model": str(args.model),
+        "robot": robot.name,
+        "trajectory": str(args.trajectory),
+        "joint_names": list(robot.joint_names),
+        **run.settings,
+    }
+    name = {"npz": "log.npz", "csv": "log.csv", "bag": "bag"}[args.format]
+    with output_folder(args.output, args.overwrite, inputs=inputs) as staging:
+        if args.format == "bag":
+            write_ros_bag(log, staging / name, robot.joint_names)
+        else:
+            save_log(log, staging / name)
+        (staging / "simulation.json").write_text(json.dumps(settings, indent=1) + "\n")
+        (staging / RUN_FILE).write_text(run_yaml(args))
+    errors = " ".join(f"{1000 * e:.3g}" for e in run.tracking_error)
+    print(
+        f"simulated {robot.name} ({robot.n} joints) for {plan.duration:.4g} s at {args.rate:g} Hz "
+        f"under {args.controller}; tracking error max [mrad]: {errors}",
+        flush=True,
+    )
+    print(f"wrote {args.output}/{name}, {args.output}/simulation.json", flush=True)
+
+
 def excite(args: argparse.Namespace) -> None:
     """``dynid excite``: optimise the experiment's trajectory and write its files."""
     import numpy as np

@@ -32,6 +32,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_residual(subcommands)
     _add_payload(subcommands)
     _add_excite(subcommands)
+    _add_simulate(subcommands)
     # Each command knows its own parser, so that an option it does not have is reported with the
     # command's usage, not the top level's (main()).
     for command in subcommands.choices.values():
@@ -270,6 +271,78 @@ def _per_joint(text: str) -> list[float]:
         raise argparse.ArgumentTypeError(
             f"expected a number or comma-separated numbers, one per joint, got {text!r}"
         ) from None
+
+
+def _add_simulate(subcommands: Any) -> None:
+    p = subcommands.add_parser(
+        "simulate",
+        help="rehearse an experiment: track a trajectory in simulation and write the log "
+        "(docs/workflow.md)",
+        description="Simulate MODEL tracking TRAJECTORY (trajectory.json of `dynid excite`, or "
+        "its folder) under a controller at its rate, with friction, sensor noise and encoder "
+        "quantisation, and write the log the controller would record in a format `dynid "
+        "identify` reads: log.npz, log.csv or a ROS 2 bag (bag/), with simulation.json (what "
+        "was simulated) and run.yaml.",
+    )
+    p.add_argument(
+        "model",
+        metavar="MODEL",
+        help="the simulated arm: a built-in model, a model file, a URDF, or the result folder of "
+        "`dynid identify --physical`",
+    )
+    p.add_argument("trajectory", metavar="TRAJECTORY", help="trajectory.json or its folder")
+    p.add_argument(
+        "--controller",
+        choices=("pd", "pd_gravity", "computed_torque"),
+        default="pd_gravity",
+        help="the control law (default pd_gravity); computed_torque and pd_gravity use MODEL",
+    )
+    p.add_argument(
+        "--kp", type=_per_joint, metavar="K", help="proportional gains: one, or one per joint"
+    )
+    p.add_argument(
+        "--kd", type=_per_joint, metavar="K", help="derivative gains: one, or one per joint"
+    )
+    p.add_argument(
+        "--bandwidth",
+        type=float,
+        default=10.0,
+        help="closed-loop bandwidth [Hz] of the default gains (default 10)",
+    )
+    p.add_argument(
+        "--rate", type=float, default=1000.0, help="controller and log rate [Hz] (default 1000)"
+    )
+    p.add_argument("--sensor-noise", type=float, default=0.0, help="torque sensor noise std [N m]")
+    p.add_argument(
+        "--torque-noise",
+        type=float,
+        default=0.0,
+        help="disturbance torque std [N m] acting on the arm (not logged)",
+    )
+    p.add_argument(
+        "--encoder-counts",
+        type=float,
+        help="encoder counts per revolution (or metre): the logged positions are quantised",
+    )
+    p.add_argument(
+        "--no-friction", action="store_true", help="no joint friction in the simulated arm"
+    )
+    p.add_argument(
+        "--velocities",
+        action="store_true",
+        help="log the joint velocities too (exact, as a robot that logs its own would)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="seed of the noises (default 0)")
+    p.add_argument(
+        "--format",
+        choices=("npz", "csv", "bag"),
+        default="npz",
+        help="the log's format (default npz; bag: a ROS 2 MCAP bag, needs dynid[ros])",
+    )
+    _add_links(p)
+    _add_config(p)
+    _add_output(p, "dynid-simulate")
+    p.set_defaults(run=commands.simulate)
 
 
 def _add_excite(subcommands: Any) -> None:
