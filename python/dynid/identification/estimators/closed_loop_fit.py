@@ -1,0 +1,134 @@
+"""The weighted solve shared by IDIM-IV and DIDIM: theta = (Z^T W Y)^-1 Z^T W tau over the rows
+taking part, with each joint's rows weighted 1 / sigma_j^2 as WLS does, and its covariance.
+
+IDIM-IV solves it with the instruments Z of the simulated closed loop; DIDIM with Z = Y = the
+simulated regressor. With the noise covariance Omega = diag(sigma_j^2) per joint (from the
+residuals tau - Y theta, with the N - p degrees of freedom shared among the joints as in
+``dynid.least_squares``), the covariance of the estimate is the instrumental-variable sandwich
+
+    C = (Z^T W Y)^-1 Z^T W Omega W Z (Y^T W Z)^-1
+
+(Janot, Vandanjon & Gautier, IEEE TCST 2014, eq. (20) with the per-joint weighting of their
+eq. (9)); for Z = Y and W = Omega^-1 it is the WLS covariance (Y^T Omega^-1 Y)^-1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..identify import VARIANCE_FLOOR, LeastSquaresResult, relative_std
+from .base import Problem
+
+
+@dataclass(frozen=True, eq=False)
+class WeightedSolve:
+    """One solve: the estimate, its covariance and the per-joint noise of its residuals."""
+
+    theta: NDArray[np.float64]
+    covariance: NDArray[np.float64]
+    noise_variance: NDArray[np.float64]  #: (joints,) sigma_j^2 of tau - Y theta
+    residual_rms: NDArray[np.float64]  #: (joints,)
+    condition_number: float  #: of the weighted Z^T W Y, the matrix inverted
+    rank: int
+
+
+def rows(problem: Problem) -> NDArray[np.bool_]:
+    """(T, n) the rows that take part: kept, of a joint not excluded."""
+    taking = problem.keep.copy()
+    taking[:, list(problem.excluded)] = False
+    return taking
+
+
+def solve(
+    problem: Problem,
+    Z: NDArray[np.float64],
+    variance: NDArray[np.float64],
+) -> WeightedSolve:
+    """theta = (Z^T W Y)^-1 Z^T W tau with W = 1 / sigma_j^2 on joint j's rows (``variance``
+    per joint of ``problem.joints``, floored as WLS floors it); ValueError when Z^T W Y is
+    singular (the instruments do not excite every coefficient)."""
+    taking = rows(problem)
+    joints = list(problem.joints)
+    weight = np.zeros(problem.n)
+    weight[joints] = 1.0 / _floored(variance)
+    w = np.where(taking, weight, 0.0)
+    Zw = Z * w[:, :, None]
+    Y, tau = problem.Y, problem.tau
+    A = np.einsum("tjp,tjq->pq", Zw, Y)
+    scale = np.sqrt(np.abs(np.diag(A))) + (np.abs(np.diag(A)) == 0)  # column scaling
+    scaled = A / scale[:, None] / scale[None, :]
+    singular = np.linalg.svd(scaled, compute_uv=False)
+    rank = int(np.sum(singular > 1e-10 * singular[0]))
+    if rank < problem.p:
+        raise ValueError(
+            f"method: the simulated closed loop does not excite every coefficient (rank {rank} "
+            f"of {problem.p} of Z^T W Y); check the controller, the reference and the log"
+        )
+    theta = np.linalg.solve(A, np.einsum("tjp,tj->p", Zw, tau))
+    residual = np.where(taking, tau - Y @ theta, 0.0)
+    noise = noise_variance(problem, residual)
+    # The sandwich: Z^T W Omega W Z with Omega = diag(sigma_j^2) of these residuals.
+    omega = np.zeros(problem.n)
+    omega[joints] = noise
+    middle = np.einsum("tjp,tj,tjq->pq", Zw, np.where(taking, omega, 0.0), Zw)
+    inverse = np.linalg.inv(A)
+    covariance = inverse @ middle @ inverse.T
+    covariance = 0.5 * (covariance + covariance.T)
+    counts = taking[:, joints].sum(axis=0)
+    rms = np.sqrt((residual[:, joints] ** 2).sum(axis=0) / counts)
+    return WeightedSolve(theta, covariance, noise, rms, float(singular[0] / singular[-1]), rank)
+
+
+def noise_variance(problem: Problem, residual: NDArray[np.float64]) -> NDArray[np.float64]:
+    """sigma_j^2 = ||r_j||^2 / (N_j - p N_j / N) per joint of ``problem.joints`` (the N - p
+    degrees of freedom shared in proportion to the rows, as ``dynid.least_squares``)."""
+    taking = rows(problem)
+    joints = list(problem.joints)
+    counts = taking[:, joints].sum(axis=0).astype(float)
+    total = counts.sum()
+    if total <= problem.p:
+        raise ValueError(f"log: {int(total)} rows for {problem.p} coefficients; more are needed")
+    squares = (np.where(taking, residual, 0.0)[:, joints] ** 2).sum(axis=0)
+    variance: NDArray[np.float64] = squares / (counts * (total - problem.p) / total)
+    return variance
+
+
+def result(problem: Problem, fit: WeightedSolve, method: str) -> LeastSquaresResult:
+    """The estimate as the log identification's result holds it."""
+    std = np.sqrt(np.maximum(np.diag(fit.covariance), 0.0))
+    return LeastSquaresResult(
+        theta=fit.theta,
+        std=std,
+        relative_std=relative_std(fit.theta, std),
+        covariance=fit.covariance,
+        condition_number=fit.condition_number,
+        rank=fit.rank,
+        method=method,
+        noise_variance=fit.noise_variance,
+        residual_rms=fit.residual_rms,
+        names=list(problem.names),
+        excluded=problem.excluded,
+        joints=problem.joints,
+    )
+
+
+def settled(old: NDArray[np.float64], new: WeightedSolve, threshold: float) -> tuple[bool, float]:
+    """Whether no coefficient moved by more than ``threshold`` of its std, and the largest
+    move in std units."""
+    std = np.sqrt(np.maximum(np.diag(new.covariance), 0.0))
+    moved = np.abs(new.theta - old)
+    scaled = np.where(std > 0, moved / np.where(std > 0, std, 1.0), np.where(moved > 0, np.inf, 0))
+    step = float(scaled.max())
+    return step <= threshold, step
+
+
+def _floored(variance: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The variances as WLS uses them: at least VARIANCE_FLOOR times the largest; all ones when
+    every joint fits exactly."""
+    largest = float(np.max(variance))
+    if not np.isfinite(largest) or largest <= 0:
+        return np.ones_like(variance)
+    return np.maximum(variance, VARIANCE_FLOOR * largest)

@@ -1,0 +1,75 @@
+"""IDIM-IV: the inverse dynamic identification model with instrumental variables, the
+instruments from the model simulated in closed loop (Janot, Vandanjon & Gautier, "A generic
+instrumental variable approach for industrial robot identification", IEEE TCST 22(1), 2014;
+Gautier, Janot & Vandanjon, IEEE TCST 21(2), 2013, section II).
+
+Closed-loop data defeat least squares: the controller feeds the measurement noise back into the
+torque, and the regressor Y is built from the same noisy positions (velocities and accelerations
+differentiated from them), so Y is correlated with the error tau - Y theta and OLS/WLS are
+biased. Instruments Z correlated with the true regressor but not with the noise remove the bias:
+Z is the regressor of the run *simulated* with the current estimate, under the same controller
+and reference (:mod:`.closed_loop_model`), noise-free by construction. Iterated from the WLS
+estimate theta_0:
+
+    Z_k = Y(q_s(theta_k), qd_s(theta_k), qdd_s(theta_k)),
+    theta_{k+1} = (Z_k^T W Y)^-1 Z_k^T W tau,                 (Janot et al. 2014, eq. (17))
+
+W = diag(1 / sigma_j^2) per joint as WLS, the sigma_j from the residuals of theta_k; until no
+coefficient moves by more than SETTLED_STD of its std (usually 2-4 iterations), at most
+``iterations`` times. The covariance is the IV sandwich of :mod:`.closed_loop_fit`.
+
+The columns of the blocks (offsets, asymmetric friction, position torque) are no part of the
+simulated robot; their instruments are their own columns at the simulated states, which stay
+uncorrelated with the noise, so the estimate keeps its consistency, the simulated run only
+following the real one less closely.
+"""
+
+from __future__ import annotations
+
+import time
+
+from .base import EstimatorFit, Problem
+from .closed_loop_fit import result, settled, solve
+from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
+
+
+def instrumental_variables(problem: Problem) -> EstimatorFit:
+    """IDIM-IV on ``problem`` (module docstring); options of :mod:`.closed_loop_model`."""
+    loop = closed_loop(problem)
+    theta = problem.start.theta
+    variance = problem.start.noise_variance
+    steps: list[float] = []
+    simulated = 0.0
+    done = False
+    fit = None
+    for _ in range(loop.iterations):
+        began = time.perf_counter()
+        sims = simulate_runs(problem, loop, plant(problem, theta))
+        Z = simulated_columns(problem, sims)
+        simulated += time.perf_counter() - began
+        fit = solve(problem, Z, variance)
+        done, step = settled(theta, fit, SETTLED_STD)
+        steps.append(step)
+        theta, variance = fit.theta, fit.noise_variance
+        if done:
+            break
+    assert fit is not None  # iterations >= 1
+    notes = []
+    if not done:
+        notes.append(
+            f"iv: not settled after {loop.iterations} iterations (last step "
+            f"{steps[-1]:.3g} std); raise iterations or check the controller's description"
+        )
+    if problem.model.blocks:
+        keys = ", ".join(b.key for b in problem.model.blocks)
+        notes.append(f"iv: the columns of {keys} are not simulated; their own columns at the "
+                     "simulated states are their instruments")
+    report = {
+        **loop.report(),
+        "iterations": len(steps),
+        "settled": done,
+        "steps_std": steps,
+        "simulation_s": simulated,
+    }
+    return EstimatorFit(result(problem, fit, "iv"), None, report, tuple(notes))
+
