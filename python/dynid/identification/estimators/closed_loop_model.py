@@ -68,13 +68,11 @@ class ClosedLoop:
     control_period: float | None  #: None: each run's sample period
     iterations: int
 
-    def report(self) -> dict[str, Any]:
-        """What the result file records of the loop (JSON-ready)."""
+    def report(self, options: Mapping[str, Any]) -> dict[str, Any]:
+        """What the result file records of the loop, JSON-ready: the options as given (arrays
+        as lists, callables and robots by their kind, paths as text) and the controller."""
         name = self.controller if isinstance(self.controller, str) else "python"
-        out: dict[str, Any] = {"controller": name}
-        if self.kp is not None and self.kd is not None:
-            out.update(kp=self.kp.tolist(), kd=self.kd.tolist())
-        return out
+        return {"options": {k: _plain(v) for k, v in options.items()}, "controller": name}
 
 
 def closed_loop(problem: Problem) -> ClosedLoop:
@@ -271,3 +269,18 @@ def _controller_model(value: Any, robot: Robot) -> Robot:
             f"got {getattr(value, 'n', type(value).__name__)}"
         )
     return value
+
+
+def _plain(value: Any) -> Any:
+    """An option's value for result.json."""
+    if isinstance(value, (str, int, float, bool)) or value is None:
+        return value
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, Robot):
+        return f"robot {value.name}"
+    if isinstance(value, Mapping):
+        return "samples"
+    if callable(value):
+        return "python callable"
+    return np.asarray(value, dtype=float).tolist()

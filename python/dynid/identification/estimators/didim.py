@@ -67,7 +67,7 @@ def didim(problem: Problem) -> EstimatorFit:
             f"{steps[-1]:.3g} std); raise iterations or check the controller's description"
         )
     report = {
-        **loop.report(),
+        **loop.report(problem.options),
         "iterations": len(steps),
         "settled": done,
         "steps_std": steps,

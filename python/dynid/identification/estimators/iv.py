@@ -65,7 +65,7 @@ def instrumental_variables(problem: Problem) -> EstimatorFit:
         notes.append(f"iv: the columns of {keys} are not simulated; their own columns at the "
                      "simulated states are their instruments")
     report = {
-        **loop.report(),
+        **loop.report(problem.options),
         "iterations": len(steps),
         "settled": done,
         "steps_std": steps,
