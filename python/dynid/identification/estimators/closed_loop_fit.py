@@ -14,6 +14,8 @@ eq. (9)); for Z = Y and W = Omega^-1 it is the WLS covariance (Y^T Omega^-1 Y)^-
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -172,3 +174,51 @@ def _floored(variance: NDArray[np.float64]) -> NDArray[np.float64]:
     if not np.isfinite(largest) or largest <= 0:
         return np.ones_like(variance)
     return np.maximum(variance, VARIANCE_FLOOR * largest)
+
+
+@dataclass(frozen=True, eq=False)
+class Iterated:
+    """The last solve of an iteration and how it went."""
+
+    fit: WeightedSolve
+    steps: list[float]  #: the largest move of each iteration, in std
+    settled: bool
+    simulation_s: float  #: wall time spent simulating the loop (and its regressor)
+
+
+def iterate(
+    problem: Problem,
+    iterations: int,
+    simulated: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    one_solve: Callable[[NDArray[np.float64], NDArray[np.float64]], WeightedSolve],
+    threshold: float,
+) -> Iterated:
+    """theta_{k+1} = F(theta_k) from the WLS estimate: ``simulated(theta)`` the regressor of
+    the loop simulated with theta, ``one_solve(Z, variance)`` the solve on it. Coulomb
+    friction makes F piecewise continuous only (a simulated velocity crossing zero between two
+    other samples flips a sign(qd) entry), and near the fixed point the plain iteration can
+    then jump between two points a fraction of a std apart; when a step does not halve the one
+    before, the next ones are relaxed, theta + lambda (F(theta) - theta), lambda halved down to
+    1/8 (Krasnoselskii-Mann averaging)."""
+    theta = problem.start.theta
+    variance = problem.start.noise_variance
+    steps: list[float] = []
+    spent = 0.0
+    relax = 1.0
+    done = False
+    fit = None
+    for _ in range(iterations):
+        began = time.perf_counter()
+        Z = simulated(theta)
+        spent += time.perf_counter() - began
+        fit = one_solve(Z, variance)
+        done, step = settled(theta, fit, threshold)
+        steps.append(step)
+        if done:
+            break
+        if len(steps) > 1 and step > 0.5 * steps[-2]:
+            relax = max(relax / 2, 1 / 8)
+        theta = theta + relax * (fit.theta - theta)
+        variance = fit.noise_variance
+    assert fit is not None  # iterations >= 1
+    return Iterated(fit, steps, done, spent)

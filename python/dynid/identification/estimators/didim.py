@@ -24,11 +24,13 @@ refuses them.
 
 from __future__ import annotations
 
-import time
 from dataclasses import replace
 
+import numpy as np
+from numpy.typing import NDArray
+
 from .base import EstimatorFit, Problem
-from .closed_loop_fit import result, settled, solve
+from .closed_loop_fit import WeightedSolve, iterate, result, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
 
 
@@ -41,25 +43,16 @@ def didim(problem: Problem) -> EstimatorFit:
             f"{keys}; leave them out (offset, asymmetric friction, position torque) or use 'iv'"
         )
     loop = closed_loop(problem)
-    theta = problem.start.theta
-    variance = problem.start.noise_variance
-    steps: list[float] = []
-    simulated = 0.0
-    done = False
-    fit = None
-    for _ in range(loop.iterations):
-        began = time.perf_counter()
-        sims = simulate_runs(problem, loop, plant(problem, theta))
-        Y_s = simulated_columns(problem, sims)
-        simulated += time.perf_counter() - began
+
+    def regressor(theta: NDArray[np.float64]) -> NDArray[np.float64]:
+        return simulated_columns(problem, simulate_runs(problem, loop, plant(problem, theta)))
+
+    def one_solve(Y_s: NDArray[np.float64], variance: NDArray[np.float64]) -> WeightedSolve:
         # Y_s is both the instrument and the regressor: the LS of tau on the simulated run.
-        fit = solve(replace(problem, Y=Y_s), Y_s, variance)
-        done, step = settled(theta, fit, SETTLED_STD)
-        steps.append(step)
-        theta, variance = fit.theta, fit.noise_variance
-        if done:
-            break
-    assert fit is not None  # iterations >= 1
+        return solve(replace(problem, Y=Y_s), Y_s, variance)
+
+    run = iterate(problem, loop.iterations, regressor, one_solve, SETTLED_STD)
+    fit, steps, done = run.fit, run.steps, run.settled
     notes = []
     if not done:
         notes.append(
@@ -71,6 +64,6 @@ def didim(problem: Problem) -> EstimatorFit:
         "iterations": len(steps),
         "settled": done,
         "steps_std": steps,
-        "simulation_s": simulated,
+        "simulation_s": run.simulation_s,
     }
     return EstimatorFit(result(problem, fit, "didim"), None, report, tuple(notes))

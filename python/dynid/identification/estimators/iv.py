@@ -26,34 +26,26 @@ following the real one less closely.
 
 from __future__ import annotations
 
-import time
+import numpy as np
+from numpy.typing import NDArray
 
 from .base import EstimatorFit, Problem
-from .closed_loop_fit import result, settled, solve
+from .closed_loop_fit import WeightedSolve, iterate, result, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
 
 
 def instrumental_variables(problem: Problem) -> EstimatorFit:
     """IDIM-IV on ``problem`` (module docstring); options of :mod:`.closed_loop_model`."""
     loop = closed_loop(problem)
-    theta = problem.start.theta
-    variance = problem.start.noise_variance
-    steps: list[float] = []
-    simulated = 0.0
-    done = False
-    fit = None
-    for _ in range(loop.iterations):
-        began = time.perf_counter()
-        sims = simulate_runs(problem, loop, plant(problem, theta))
-        Z = simulated_columns(problem, sims)
-        simulated += time.perf_counter() - began
-        fit = solve(problem, Z, variance)
-        done, step = settled(theta, fit, SETTLED_STD)
-        steps.append(step)
-        theta, variance = fit.theta, fit.noise_variance
-        if done:
-            break
-    assert fit is not None  # iterations >= 1
+
+    def instruments(theta: NDArray[np.float64]) -> NDArray[np.float64]:
+        return simulated_columns(problem, simulate_runs(problem, loop, plant(problem, theta)))
+
+    def one_solve(Z: NDArray[np.float64], variance: NDArray[np.float64]) -> WeightedSolve:
+        return solve(problem, Z, variance)
+
+    run = iterate(problem, loop.iterations, instruments, one_solve, SETTLED_STD)
+    fit, steps, done = run.fit, run.steps, run.settled
     notes = []
     if not done:
         notes.append(
@@ -69,7 +61,7 @@ def instrumental_variables(problem: Problem) -> EstimatorFit:
         "iterations": len(steps),
         "settled": done,
         "steps_std": steps,
-        "simulation_s": simulated,
+        "simulation_s": run.simulation_s,
     }
     return EstimatorFit(result(problem, fit, "iv"), None, report, tuple(notes))
 
