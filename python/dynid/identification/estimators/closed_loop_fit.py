@@ -8,15 +8,18 @@ residuals tau - Y theta, with the N - p degrees of freedom shared among the join
 
     C = (Z^T W Y)^-1 Z^T W Omega W Z (Y^T W Z)^-1
 
-(Janot, Vandanjon & Gautier, IEEE TCST 2014, eq. (20) with the per-joint weighting of their
-eq. (9)); for Z = Y and W = Omega^-1 it is the WLS covariance (Y^T Omega^-1 Y)^-1.
+(the IV covariance of Janot, Vandanjon & Gautier, IEEE TCST 2014, with WLS's per-joint
+weighting); for Z = Y and W = Omega^-1 it is the WLS covariance (Y^T Omega^-1 Y)^-1. The noise
+of closed-loop data, filtered and differentiated, is far from white; the middle factor is
+therefore computed with a noise model per joint (:func:`_noise_moment`), which for white noise
+is the formula above.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -176,13 +179,22 @@ def _floored(variance: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.maximum(variance, VARIANCE_FLOOR * largest)
 
 
+#: Relaxation of the iteration: halved down to this when a step does not halve the one before.
+SMALLEST_RELAXATION = 1 / 64
+
+#: At the smallest relaxation, an iterate that moves by less than this many std per iteration
+#: has settled at a jump of the map (see :func:`iterate`).
+SETTLED_AT_JUMP_STD = 0.01
+
+
 @dataclass(frozen=True, eq=False)
 class Iterated:
     """The last solve of an iteration and how it went."""
 
     fit: WeightedSolve
-    steps: list[float]  #: the largest move of each iteration, in std
+    steps: list[float]  #: |F(theta_k) - theta_k| of each iteration, largest in std
     settled: bool
+    at_jump: bool  #: settled where F jumps over theta (the last step is the jump's size)
     simulation_s: float  #: wall time spent simulating the loop (and its regressor)
 
 
@@ -194,18 +206,23 @@ def iterate(
     threshold: float,
 ) -> Iterated:
     """theta_{k+1} = F(theta_k) from the WLS estimate: ``simulated(theta)`` the regressor of
-    the loop simulated with theta, ``one_solve(Z, variance)`` the solve on it. Coulomb
-    friction makes F piecewise continuous only (a simulated velocity crossing zero between two
-    other samples flips a sign(qd) entry), and near the fixed point the plain iteration can
-    then jump between two points a fraction of a std apart; when a step does not halve the one
-    before, the next ones are relaxed, theta + lambda (F(theta) - theta), lambda halved down to
-    1/8 (Krasnoselskii-Mann averaging)."""
+    the loop simulated with theta, ``one_solve(Z, variance)`` the solve on it; settled when
+    no coefficient moves by more than ``threshold`` std.
+
+    Coulomb friction makes F piecewise continuous only: a simulated velocity that crosses zero
+    on the other side of a sample instant flips a sign(qd) entry of the simulated regressor,
+    and near the solution F may jump over it, the plain iteration then cycling between points
+    a fraction of a std apart. So when a step does not halve the one before, the next ones are
+    relaxed, theta + lambda (F(theta) - theta), lambda halved down to SMALLEST_RELAXATION
+    (Krasnoselskii-Mann averaging); the iterate then converges to the point where F jumps over
+    it, taken as settled when it moves by less than SETTLED_AT_JUMP_STD per iteration (the
+    report keeps the jump's size, the last step)."""
     theta = problem.start.theta
     variance = problem.start.noise_variance
     steps: list[float] = []
     spent = 0.0
     relax = 1.0
-    done = False
+    done = at_jump = False
     fit = None
     for _ in range(iterations):
         began = time.perf_counter()
@@ -216,9 +233,14 @@ def iterate(
         steps.append(step)
         if done:
             break
+        if relax == SMALLEST_RELAXATION and relax * step <= SETTLED_AT_JUMP_STD:
+            # The estimate is the iterate itself, between F's values on the two sides.
+            fit = replace(fit, theta=theta)
+            done = at_jump = True
+            break
         if len(steps) > 1 and step > 0.5 * steps[-2]:
-            relax = max(relax / 2, 1 / 8)
+            relax = max(relax / 2, SMALLEST_RELAXATION)
         theta = theta + relax * (fit.theta - theta)
         variance = fit.noise_variance
     assert fit is not None  # iterations >= 1
-    return Iterated(fit, steps, done, spent)
+    return Iterated(fit, steps, done, at_jump, spent)

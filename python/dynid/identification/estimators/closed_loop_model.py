@@ -20,7 +20,7 @@ log's clock), ``kp``, ``kd`` (scalars or one per joint), ``reference`` (a file, 
 ``{"t", "q_d"[, "qd_d", "qdd_d"]}`` or a callable ``reference(t) -> (q_d, qd_d, qdd_d)``, all on
 the log's clock), ``controller_model`` (the robot the controller's gravity / computed torque
 use; default the identified robot as given), ``control_period`` (the controller's period in s;
-default the prepared log's sample period), ``iterations`` (at most; default 20).
+default the prepared log's sample period), ``iterations`` (at most; default 30).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ OPTIONS = (
     "control_period",
     "iterations",
 )
-DEFAULT_ITERATIONS = 20
+DEFAULT_ITERATIONS = 30
 
 #: An iteration has settled when no coefficient moved by more than this many of its standard
 #: deviations (the estimate's own uncertainty is the natural scale of "no longer changes").

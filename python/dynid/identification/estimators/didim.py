@@ -5,16 +5,18 @@ error method for parameter identification of robot dynamics", IEEE TCST 21(2), 2
 The estimate minimises ||tau - tau_s(theta)||_W, tau the measured (commanded) torque and
 tau_s(theta) the torque of the controller in the run simulated with theta, under the same
 controller and reference (:mod:`.closed_loop_model`). The simulator integrates the direct model,
-so tau_s = Y_s(theta) theta exactly, Y_s the regressor of the simulated states; Gauss-Newton with
-Y_s as the Jacobian (the paper's eqs. (19)-(22): the sensitivity of the simulated states to theta
-neglected) makes each iteration a weighted least squares on the simulated regressor,
+so tau_s = Y_s(theta) theta, Y_s the regressor of the simulated states (exactly but for the
+plant's Coulomb law, tanh(qd / 1e-3) for the column's sign(qd)); Gauss-Newton with Y_s as the
+Jacobian (as the paper: the sensitivity of the simulated states to theta neglected) makes each
+iteration a weighted least squares on the simulated regressor,
 
     theta_{k+1} = (Y_s(theta_k)^T W Y_s(theta_k))^-1 Y_s(theta_k)^T W tau,
 
 started from the WLS estimate, W = diag(1 / sigma_j^2) per joint as WLS, the sigma_j from the
-residuals of theta_k; until no coefficient moves by more than SETTLED_STD of its std (the paper:
-2-3 iterations), at most ``iterations`` times. The covariance is the WLS one of the last
-iteration (:mod:`.closed_loop_fit` with Z = Y_s). Noise on the measured positions never enters
+residuals of theta_k; until no coefficient moves by more than SETTLED_STD of its std (measured:
+5 iterations typically), at most ``iterations`` times (:func:`.closed_loop_fit.iterate`). The
+covariance is the WLS one of the last iteration (:mod:`.closed_loop_fit` with Z = Y_s and the
+noise model of each joint's residual). Noise on the measured positions never enters
 the regressor, only tau, which is why the estimate is unbiased on closed-loop data.
 
 Unlike IDIM-IV, the simulated run must be the model's exact output: the columns of the blocks
@@ -32,6 +34,9 @@ from numpy.typing import NDArray
 from .base import EstimatorFit, Problem
 from .closed_loop_fit import WeightedSolve, iterate, result, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
+
+
+NAME = "didim"
 
 
 def didim(problem: Problem) -> EstimatorFit:
@@ -56,13 +61,19 @@ def didim(problem: Problem) -> EstimatorFit:
     notes = []
     if not done:
         notes.append(
-            f"didim: not settled after {loop.iterations} iterations (last step "
+            f"{NAME}: not settled after {loop.iterations} iterations (last step "
             f"{steps[-1]:.3g} std); raise iterations or check the controller's description"
+        )
+    if run.at_jump:
+        notes.append(
+            f"{NAME}: settled where the iteration's map jumps (a simulated velocity's sign "
+            f"flips between two samples): the jump is {steps[-1]:.2g} std"
         )
     report = {
         **loop.report(problem.options),
         "iterations": len(steps),
         "settled": done,
+        "settled_at_jump": run.at_jump,
         "steps_std": steps,
         "simulation_s": run.simulation_s,
     }

@@ -12,11 +12,12 @@ and reference (:mod:`.closed_loop_model`), noise-free by construction. Iterated 
 estimate theta_0:
 
     Z_k = Y(q_s(theta_k), qd_s(theta_k), qdd_s(theta_k)),
-    theta_{k+1} = (Z_k^T W Y)^-1 Z_k^T W tau,                 (Janot et al. 2014, eq. (17))
+    theta_{k+1} = (Z_k^T W Y)^-1 Z_k^T W tau,
 
 W = diag(1 / sigma_j^2) per joint as WLS, the sigma_j from the residuals of theta_k; until no
-coefficient moves by more than SETTLED_STD of its std (usually 2-4 iterations), at most
-``iterations`` times. The covariance is the IV sandwich of :mod:`.closed_loop_fit`.
+coefficient moves by more than SETTLED_STD of its std (measured: 4 iterations typically), at most
+``iterations`` times (:func:`.closed_loop_fit.iterate`: relaxed where Coulomb friction makes
+the map jump). The covariance is the IV sandwich of :mod:`.closed_loop_fit`.
 
 The columns of the blocks (offsets, asymmetric friction, position torque) are no part of the
 simulated robot; their instruments are their own columns at the simulated states, which stay
@@ -34,6 +35,9 @@ from .closed_loop_fit import WeightedSolve, iterate, result, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
 
 
+NAME = "iv"
+
+
 def instrumental_variables(problem: Problem) -> EstimatorFit:
     """IDIM-IV on ``problem`` (module docstring); options of :mod:`.closed_loop_model`."""
     loop = closed_loop(problem)
@@ -49,17 +53,23 @@ def instrumental_variables(problem: Problem) -> EstimatorFit:
     notes = []
     if not done:
         notes.append(
-            f"iv: not settled after {loop.iterations} iterations (last step "
+            f"{NAME}: not settled after {loop.iterations} iterations (last step "
             f"{steps[-1]:.3g} std); raise iterations or check the controller's description"
         )
     if problem.model.blocks:
         keys = ", ".join(b.key for b in problem.model.blocks)
-        notes.append(f"iv: the columns of {keys} are not simulated; their own columns at the "
+        notes.append(f"{NAME}: the columns of {keys} are not simulated; their own columns at the "
                      "simulated states are their instruments")
+    if run.at_jump:
+        notes.append(
+            f"{NAME}: settled where the iteration's map jumps (a simulated velocity's sign "
+            f"flips between two samples): the jump is {steps[-1]:.2g} std"
+        )
     report = {
         **loop.report(problem.options),
         "iterations": len(steps),
         "settled": done,
+        "settled_at_jump": run.at_jump,
         "steps_std": steps,
         "simulation_s": run.simulation_s,
     }
