@@ -61,7 +61,7 @@ def noisy_log(seed: int, seconds: float = 16.0, dt: float = 1e-3) -> Log:
     q_d, qd_d, _ = reference(T0 + np.arange(steps + 1) * dt)
 
     def pd(t, q, qd):  # a Python controller: the noise enters the loop
-        k = int(round(t / dt))
+        k = round(t / dt)
         velocity = qd + (e[k] - e[k - 1]) / dt if k else qd
         return KP * (q_d[k] - q - e[k]) + KD * (qd_d[k] - velocity)
 
@@ -186,8 +186,12 @@ def test_python_controller_and_reference_file(tmp_path):
         {"controller": python_pd},
         {"controller": "pd", "kp": KP, "kd": KD, "reference": str(tmp_path / "ref.npz")},
         {"controller": "pd", "kp": KP, "kd": KD, "reference": tmp_path / "ref.csv"},
-        {"controller": "pd", "kp": KP, "kd": KD, "reference": {"t": log.t, "q_d": q_d,
-                                                               "qd_d": qd_d, "qdd_d": qdd_d}},
+        {
+            "controller": "pd",
+            "kp": KP,
+            "kd": KD,
+            "reference": {"t": log.t, "q_d": q_d, "qd_d": qd_d, "qdd_d": qdd_d},
+        },
     ]
     for options in variants:
         got = identify_log(log, robot, friction=True, method="didim", estimator_options=options)
@@ -244,23 +248,43 @@ def test_plant_has_the_base_parameters_theta():
             "iterations: expected an integer >= 1",
         ),
         (
-            {"controller": "pd", "kp": 1.0, "kd": 1.0, "reference": reference,
-             "control_period": -1.0},
+            {
+                "controller": "pd",
+                "kp": 1.0,
+                "kd": 1.0,
+                "reference": reference,
+                "control_period": -1.0,
+            },
             "control_period: expected a time > 0",
         ),
         (
-            {"controller": "pd", "kp": 1.0, "kd": 1.0, "reference": reference,
-             "control_period": 3e-3},
+            {
+                "controller": "pd",
+                "kp": 1.0,
+                "kd": 1.0,
+                "reference": reference,
+                "control_period": 3e-3,
+            },
             "control_period: the samples of",
         ),
         (
-            {"controller": "pd", "kp": 1.0, "kd": 1.0, "reference": reference,
-             "controller_model": "planar_2r"},
+            {
+                "controller": "pd",
+                "kp": 1.0,
+                "kd": 1.0,
+                "reference": reference,
+                "controller_model": "planar_2r",
+            },
             "controller_model: only for",
         ),
         (
-            {"controller": "pd_gravity", "kp": 1.0, "kd": 1.0, "reference": reference,
-             "controller_model": "puma560"},
+            {
+                "controller": "pd_gravity",
+                "kp": 1.0,
+                "kd": 1.0,
+                "reference": reference,
+                "controller_model": "puma560",
+            },
             "controller_model: expected a dynid.Robot",
         ),
         ({"controller": lambda t, q, qd: q, "kp": 1.0}, "kp: not used with a Python"),
@@ -303,8 +327,20 @@ def test_cli_identify_with_iv(tmp_path, capsys):
     np.savez(tmp_path / "ref.npz", t=log.t, q_d=q_d, qd_d=qd_d, qdd_d=qdd_d)
     robot = truth()
     expected = dynid.base_parameters(robot, friction=True).values(robot)
-    common = [str(tmp_path / "log.npz"), "--model", "planar_2r", "--friction", "--kp", "400,200",
-              "--kd", "40,20", "--reference", str(tmp_path / "ref.npz"), "--controller", "pd"]
+    common = [
+        str(tmp_path / "log.npz"),
+        "--model",
+        "planar_2r",
+        "--friction",
+        "--kp",
+        "400,200",
+        "--kd",
+        "40,20",
+        "--reference",
+        str(tmp_path / "ref.npz"),
+        "--controller",
+        "pd",
+    ]
     for method in ("iv", "didim"):
         out = tmp_path / method
         assert main(["identify", *common, "--method", method, "--output", str(out)]) == 0

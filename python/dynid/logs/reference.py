@@ -146,7 +146,9 @@ def _csv(path: Path) -> dict[str, NDArray[np.float64]]:
         arrays["t"] = table[:, header.index("t")]
     for signal in SIGNALS:
         pattern = re.compile(rf"{signal}(\d+)\Z")
-        joints = sorted((int(m.group(1)), k) for k, h in enumerate(header) if (m := pattern.match(h)))
+        joints = sorted(
+            (int(m.group(1)), k) for k, h in enumerate(header) if (m := pattern.match(h))
+        )
         if joints:
             if [j for j, _ in joints] != list(range(1, len(joints) + 1)):
                 raise ValueError(

@@ -119,7 +119,8 @@ def _autoregression(e: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]
     if m == 0:
         return np.zeros(0), float(e @ e / max(len(e), 1))
     lagged = np.column_stack([e[m - k : len(e) - k] for k in range(1, m + 1)])
-    a, *_ = np.linalg.lstsq(lagged, e[m:], rcond=None)
+    solution, *_ = np.linalg.lstsq(lagged, e[m:], rcond=None)
+    a: NDArray[np.float64] = np.asarray(solution, dtype=np.float64)
     u = e[m:] - lagged @ a
     # A fit with a pole on or outside the unit circle would make H unstable: white instead.
     if a.size and np.max(np.abs(np.roots(np.concatenate([[1.0], -a])))) >= 1.0:

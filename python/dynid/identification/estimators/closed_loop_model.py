@@ -80,6 +80,9 @@ def closed_loop(problem: Problem) -> ClosedLoop:
     options: Mapping[str, Any] = problem.options
     n = problem.n
     controller = options.get("controller")
+    kp: NDArray[np.float64] | None = None
+    kd: NDArray[np.float64] | None = None
+    reference: Callable[..., Any] | None = None
     if controller is None:
         raise ValueError(
             f"controller: the closed-loop estimators need the controller of the experiment, "
@@ -96,13 +99,11 @@ def closed_loop(problem: Problem) -> ClosedLoop:
                 "reference: the trajectory the controller tracked is needed (a file with t and "
                 "q_d on the log's clock, a mapping or a callable reference(t))"
             )
-        reference: Callable[..., Any] | None = _reference(options["reference"], n)
+        reference = _reference(options["reference"], n)
     elif callable(controller):
         for name in ("kp", "kd", "reference"):
             if options.get(name) is not None:
                 raise ValueError(f"{name}: not used with a Python controller (it has its own)")
-        kp = kd = None
-        reference = None
     else:
         raise ValueError(
             f"controller: expected one of {CONTROLLERS} or a callable controller(t, q, qd) -> "
@@ -111,7 +112,9 @@ def closed_loop(problem: Problem) -> ClosedLoop:
     model = options.get("controller_model")
     if model is not None:
         if controller not in ("pd_gravity", "computed_torque"):
-            raise ValueError("controller_model: only for controller 'pd_gravity' or 'computed_torque'")
+            raise ValueError(
+                "controller_model: only for controller 'pd_gravity' or 'computed_torque'"
+            )
         model = _controller_model(model, problem.robot)
     elif controller in ("pd_gravity", "computed_torque"):
         model = problem.robot
@@ -243,11 +246,12 @@ def _reference(value: Any, n: int) -> Callable[..., Any]:
         unknown = set(value) - {"t", "q_d", "qd_d", "qdd_d"}
         if unknown or "t" not in value or "q_d" not in value:
             raise ValueError(
-                f"reference: a mapping needs t and q_d (optionally qd_d, qdd_d), got {sorted(value)}"
+                f"reference: a mapping needs t and q_d (optionally qd_d, qdd_d), got "
+                f"{sorted(value)}"
             )
         sampled = SampledReference(value["t"], value["q_d"], value.get("qd_d"), value.get("qdd_d"))
     elif callable(value):
-        return value  # type: ignore[no-any-return]
+        return value
     else:
         raise ValueError(
             f"reference: expected a file, a mapping or a callable reference(t), got "

@@ -35,7 +35,6 @@ from .base import EstimatorFit, Problem
 from .closed_loop_fit import WeightedSolve, iterate, result, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
 
-
 NAME = "didim"
 
 

@@ -34,7 +34,6 @@ from .base import EstimatorFit, Problem
 from .closed_loop_fit import WeightedSolve, iterate, result, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
 
-
 NAME = "iv"
 
 
@@ -58,8 +57,10 @@ def instrumental_variables(problem: Problem) -> EstimatorFit:
         )
     if problem.model.blocks:
         keys = ", ".join(b.key for b in problem.model.blocks)
-        notes.append(f"{NAME}: the columns of {keys} are not simulated; their own columns at the "
-                     "simulated states are their instruments")
+        notes.append(
+            f"{NAME}: the columns of {keys} are not simulated; their own columns at the "
+            "simulated states are their instruments"
+        )
     if run.at_jump:
         notes.append(
             f"{NAME}: settled where the iteration's map jumps (a simulated velocity's sign "
@@ -74,4 +75,3 @@ def instrumental_variables(problem: Problem) -> EstimatorFit:
         "simulation_s": run.simulation_s,
     }
     return EstimatorFit(result(problem, fit, "iv"), None, report, tuple(notes))
-
