@@ -162,7 +162,7 @@ def test_exact_data_give_the_truth(controller, options):
         )
         scale = np.abs(expected).max()
         np.testing.assert_allclose(got.theta, expected, rtol=0, atol=1e-9 * scale)
-        assert got.estimator["controller"] == controller
+        assert got.estimator["controller"] == controller and got.estimator["settled"]
 
 
 def test_python_controller_and_reference_file(tmp_path):

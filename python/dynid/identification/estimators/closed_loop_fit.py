@@ -164,9 +164,11 @@ def result(problem: Problem, fit: WeightedSolve, method: str) -> LeastSquaresRes
 def settled(old: NDArray[np.float64], new: WeightedSolve, threshold: float) -> tuple[bool, float]:
     """Whether no coefficient moved by more than ``threshold`` of its std, and the largest
     move in std units."""
-    std = np.sqrt(np.maximum(np.diag(new.covariance), 0.0))
+    # A std below rounding (exact data) is raised to it: moves of the last digits are no moves.
+    rounding = 1e-12 * max(float(np.abs(new.theta).max()), np.finfo(float).tiny)
+    std = np.maximum(np.sqrt(np.maximum(np.diag(new.covariance), 0.0)), rounding)
     moved = np.abs(new.theta - old)
-    scaled = np.where(std > 0, moved / np.where(std > 0, std, 1.0), np.where(moved > 0, np.inf, 0))
+    scaled = moved / std
     step = float(scaled.max())
     return step <= threshold, step
 
