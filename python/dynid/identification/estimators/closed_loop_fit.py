@@ -165,7 +165,7 @@ def settled(old: NDArray[np.float64], new: WeightedSolve, threshold: float) -> t
     """Whether no coefficient moved by more than ``threshold`` of its std, and the largest
     move in std units."""
     # A std below rounding (exact data) is raised to it: moves of the last digits are no moves.
-    rounding = 1e-12 * max(float(np.abs(new.theta).max()), np.finfo(float).tiny)
+    rounding = 1e-12 * max(float(np.abs(new.theta).max()), float(np.finfo(float).tiny))
     std = np.maximum(np.sqrt(np.maximum(np.diag(new.covariance), 0.0)), rounding)
     moved = np.abs(new.theta - old)
     scaled = moved / std
