@@ -318,6 +318,17 @@ def test_didim_refuses_blocks_iv_takes_them():
     assert any("offset" in note for note in got.training["notes"])
 
 
+def test_an_estimate_without_direct_dynamics_is_refused():
+    """Torques of the wrong sign: the WLS start is minus the truth, a robot whose M(q) is
+    negative definite, which no simulator can run: a ValueError naming the log."""
+    log = exact_log(pd_law, seconds=1.0)
+    flipped = Log(t=log.t, q=log.q, tau=-log.tau, qd=log.qd, qdd=log.qdd, source="flipped")
+    options = {"controller": "pd", "kp": KP, "kd": KD, "reference": reference}
+    for method in ("iv", "didim"):
+        with pytest.raises(ValueError, match="log: the robot of the estimate has a mass matrix"):
+            identify_log(flipped, truth(), friction=True, method=method, estimator_options=options)
+
+
 def test_cli_identify_with_iv(tmp_path, capsys):
     """dynid identify --method iv/didim on a small NPZ log with a reference file; a flag of
     theirs with --method wls is refused with exit 2."""

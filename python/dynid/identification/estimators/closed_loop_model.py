@@ -171,15 +171,27 @@ def simulate_runs(problem: Problem, loop: ClosedLoop, robot: Robot) -> list[Simu
             )
         instants = np.arange(index[-1] + 1) * dt
         controller = _controller(loop, robot, instants + run.t[0], run.t[0])
-        sim = simulate(
-            robot,
-            run.q[0],
-            run.qd[0],
-            index[-1] * dt,
-            controller,
-            dt=dt,
-            friction=bool(problem.model.rigid.friction),
-        )
+        try:
+            sim = simulate(
+                robot,
+                run.q[0],
+                run.qd[0],
+                index[-1] * dt,
+                controller,
+                dt=dt,
+                friction=bool(problem.model.rigid.friction),
+            )
+        except ValueError as exc:
+            if "positive definite" not in str(exc):
+                raise
+            # An estimate whose M(q) is not positive definite has no direct dynamics: the log
+            # leaves the inertial parameters too uncertain for a simulation of the loop.
+            raise ValueError(
+                f"log: the robot of the estimate has a mass matrix that is not positive "
+                f"definite along {run.source or 'the log'}, so the closed loop cannot be "
+                f"simulated with it (the log does not determine the inertial parameters well "
+                f"enough: a more exciting log, or method 'wls'/'ols')"
+            ) from None
         if not (np.all(np.isfinite(sim.q)) and np.all(np.isfinite(sim.tau))):
             raise ValueError(
                 "controller: the closed loop simulated with the estimate diverges (check the "
