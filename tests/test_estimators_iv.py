@@ -23,6 +23,7 @@ import pytest
 import dynid
 from dynid.cli import main
 from dynid.identification.blocks.rigid_body import RigidBody
+from dynid.identification.estimators.closed_loop_fit import adjoint_filter
 from dynid.identification.estimators.closed_loop_model import plant
 from dynid.identification.log_identification import identify_log
 from dynid.logs import Log, save_log
@@ -212,6 +213,20 @@ def test_reference_spline_is_exact_on_cubics(tmp_path):
     np.testing.assert_allclose(qdd, np.column_stack([6 * s, np.ones_like(s)]), atol=1e-10)
     with pytest.raises(ValueError, match="reference: covers t in"):
         ref(np.array([2.5]))
+
+
+@pytest.mark.parametrize("a", [[], [0.5], [1.2, -0.5, 0.1], [1.9, -0.95]])
+def test_adjoint_filter_equals_scipy_on_the_reversed_series(a):
+    """The covariance's noise-model filter (closed_loop_fit.adjoint_filter, FFT of the
+    truncated impulse response) against scipy.signal.lfilter of the time-reversed series
+    (1e-12 relative), including a pole pair at radius 0.975."""
+    from scipy.signal import lfilter
+
+    a = np.asarray(a, dtype=float)
+    x = np.random.default_rng(0).normal(size=(300, 4))
+    expected = lfilter([1.0], np.concatenate([[1.0], -a]), x[::-1], axis=0)[::-1]
+    got = adjoint_filter(a, x)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
 def test_plant_has_the_base_parameters_theta():

@@ -94,22 +94,41 @@ def _noise_moment(
     e = H u with H = 1 / (1 - a_1 z^-1 - ... - a_m z^-m) fitted to the residual by least
     squares and u white of variance s_u^2 (the noise model of the refined IV, Young 2011;
     Brunot, Janot, Young & Carrillo, Control Eng. Practice 2018). Then Z^T W e = sum_s
-    (H* Zw)_s u_s, H* the time-reversed filter, so the moment is s_u^2 (H* Zw)^T (H* Zw) per
+    (H* Zw)_s u_s, H* the time-reversed filter (:func:`adjoint_filter`), so the moment is s_u^2 (H* Zw)^T (H* Zw) per
     joint and run. For white residuals (a = 0) it is the textbook sigma^2 Z^T W^2 Z; for the
     coloured residuals of filtered, differentiated positions it is what counts: their power at
     the instruments' frequencies, not their total power."""
-    from scipy.signal import lfilter
-
     taking = rows(problem)
     moment = np.zeros((problem.p, problem.p))
     for begin, end in zip(problem.starts[:-1], problem.starts[1:]):
         for j in problem.joints:
             e = np.where(taking[begin:end, j], residual[begin:end, j], 0.0)
             a, innovation = _autoregression(e)
-            z = Zw[begin:end, j, :][::-1]
-            filtered = lfilter([1.0], np.concatenate([[1.0], -a]), z, axis=0)[::-1]
+            filtered = adjoint_filter(a, Zw[begin:end, j, :])
             moment += innovation * filtered.T @ filtered
     return moment
+
+
+def adjoint_filter(a: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(H* x)_s = sum_{k >= 0} h_k x_{s+k} along axis 0, h the impulse response of
+    H = 1 / (1 - a_1 z^-1 - ... - a_m z^-m) (stable): the time-reversed all-pole filter. h is
+    computed until it has decayed below 1e-13 of its peak (at most len(x) samples), the sum by
+    FFT convolution."""
+    T = x.shape[0]
+    m = a.size
+    h = [1.0]
+    peak = 1.0
+    while len(h) < T:
+        value = sum(a[k] * h[-1 - k] for k in range(min(m, len(h))))
+        h.append(value)
+        peak = max(peak, abs(value))
+        if len(h) > m and max(abs(v) for v in h[-max(m, 1) :]) < 1e-13 * peak:
+            break
+    response = np.asarray(h)
+    size = 1 << int(np.ceil(np.log2(T + response.size)))
+    spectrum = np.fft.rfft(x[::-1], size, axis=0) * np.fft.rfft(response, size)[:, None]
+    out: NDArray[np.float64] = np.fft.irfft(spectrum, size, axis=0)[:T][::-1]
+    return out
 
 
 def _autoregression(e: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
