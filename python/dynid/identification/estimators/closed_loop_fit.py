@@ -94,8 +94,8 @@ def _noise_moment(
     e = H u with H = 1 / (1 - a_1 z^-1 - ... - a_m z^-m) fitted to the residual by least
     squares and u white of variance s_u^2 (the noise model of the refined IV, Young 2011;
     Brunot, Janot, Young & Carrillo, Control Eng. Practice 2018). Then Z^T W e = sum_s
-    (H* Zw)_s u_s, H* the time-reversed filter (:func:`adjoint_filter`), so the moment is s_u^2 (H* Zw)^T (H* Zw) per
-    joint and run. For white residuals (a = 0) it is the textbook sigma^2 Z^T W^2 Z; for the
+    (H* Zw)_s u_s, H* the time-reversed filter (:func:`adjoint_filter`), so the moment is
+    s_u^2 (H* Zw)^T (H* Zw) per joint and run. For white residuals (a = 0) it is the textbook sigma^2 Z^T W^2 Z; for the
     coloured residuals of filtered, differentiated positions it is what counts: their power at
     the instruments' frequencies, not their total power."""
     taking = rows(problem)
