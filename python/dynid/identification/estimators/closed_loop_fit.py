@@ -95,9 +95,9 @@ def _noise_moment(
     squares and u white of variance s_u^2 (the noise model of the refined IV, Young 2011;
     Brunot, Janot, Young & Carrillo, Control Eng. Practice 2018). Then Z^T W e = sum_s
     (H* Zw)_s u_s, H* the time-reversed filter (:func:`adjoint_filter`), so the moment is
-    s_u^2 (H* Zw)^T (H* Zw) per joint and run. For white residuals (a = 0) it is the textbook sigma^2 Z^T W^2 Z; for the
-    coloured residuals of filtered, differentiated positions it is what counts: their power at
-    the instruments' frequencies, not their total power."""
+    s_u^2 (H* Zw)^T (H* Zw) per joint and run. For white residuals (a = 0) it is the textbook
+    sigma^2 Z^T W^2 Z; for the coloured residuals of filtered, differentiated positions it is
+    what counts: their power at the instruments' frequencies, not their total power."""
     taking = rows(problem)
     moment = np.zeros((problem.p, problem.p))
     for begin, end in zip(problem.starts[:-1], problem.starts[1:]):
