@@ -269,7 +269,20 @@ def _preparation_notes(result: Any, logs: list[Any]) -> str:
 def identify_inputs(args: argparse.Namespace) -> list[str | None]:
     """The files ``dynid identify`` reads (options not given are None; built-in model names and
     payload numbers are no files), which ``--overwrite`` must never delete."""
-    return [*args.log, args.model, args.prior, args.payload_log, args.payload, args.config]
+    return [
+        *args.log,
+        args.model,
+        args.prior,
+        args.payload_log,
+        args.payload,
+        args.config,
+        *closed_loop_inputs(args),
+    ]
+
+
+def closed_loop_inputs(args: argparse.Namespace) -> list[str | None]:
+    """The files of --method iv/didim: --reference, --controller-model."""
+    return [getattr(args, "reference", None), getattr(args, "controller_model", None)]
 
 
 def model_links(args: argparse.Namespace, source: Any) -> dict[str, str | None]:

@@ -109,6 +109,7 @@ def _add_identify(subcommands: Any) -> None:
     )
     _add_robust_estimators(p)
     _add_current(p)
+    _add_closed_loop_estimators(p)
     _add_preparation(p)
     _add_motor_side(p)
     _add_output(p, "dynid-identify")
@@ -452,6 +453,64 @@ def _add_excite(subcommands: Any) -> None:
     p.add_argument("--maxiter", type=int, default=200, help="SLSQP iterations (default 200)")
     _add_output(p, "dynid-excite")
     p.set_defaults(run=commands.excite)
+
+
+def _add_closed_loop_estimators(p: argparse.ArgumentParser) -> None:
+    """The options of --method iv and --method didim (identification/estimators/
+    closed_loop_model.py): the controller of the experiment, simulated with the estimate."""
+    p.add_argument(
+        "--controller",
+        choices=("pd", "pd_gravity", "computed_torque"),
+        help="with --method iv/didim: the control law of the experiment (PD, PD + gravity "
+        "of --controller-model, computed torque of --controller-model; docs/identification.md)",
+    )
+    p.add_argument(
+        "--kp",
+        type=_gains,
+        metavar="K[,K...]",
+        help="with --method iv/didim: the controller's position gains, one or one per joint",
+    )
+    p.add_argument(
+        "--kd",
+        type=_gains,
+        metavar="K[,K...]",
+        help="with --method iv/didim: the controller's velocity gains, one or one per joint",
+    )
+    p.add_argument(
+        "--reference",
+        metavar="FILE",
+        help="with --method iv/didim: the trajectory the controller tracked, an .npz (t, q_d"
+        "[, qd_d, qdd_d]) or .csv (t,q_d1..q_dn[,...]) on the log's clock (docs/identification.md)",
+    )
+    p.add_argument(
+        "--controller-model",
+        metavar="MODEL",
+        help="with --controller pd_gravity/computed_torque: the model the controller uses "
+        "(built-in name or model file; default --model)",
+    )
+    p.add_argument(
+        "--control-period",
+        type=float,
+        metavar="S",
+        help="with --method iv/didim: the controller's period [s] (default: the prepared "
+        "log's sample period; the log's samples must be whole periods apart)",
+    )
+    if "--iterations" not in p._option_string_actions:  # other iterative estimators share it
+        p.add_argument(
+            "--iterations",
+            type=int,
+            metavar="N",
+            help="iterative estimators (iv, didim, ...): at most N iterations",
+        )
+
+
+def _gains(text: str) -> float | list[float]:
+    """--kp, --kd: one number or a comma-separated list, one per joint."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected K or K1,K2,...; got {text!r}") from None
+    return values[0] if len(values) == 1 else values
 
 
 def _add_current(p: argparse.ArgumentParser) -> None:

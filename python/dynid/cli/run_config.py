@@ -179,6 +179,8 @@ def _value(action: argparse.Action, value: Any, key: str) -> Any:
             raise ValueError(f"{key}: expected a number, got {value!r}")
         value = float(value)
     elif callable(action.type):  # a parser's own type (--method, --rest-velocity): its check
+        if isinstance(value, list) and all(_number(v) for v in value):  # --kp 1,2 as a list
+            value = ",".join(repr(float(v)) for v in value)
         if isinstance(value, bool) or not isinstance(value, (str, int, float)):
             raise ValueError(f"{key}: expected a string or a number, got {value!r}")
         try:
@@ -192,3 +194,7 @@ def _value(action: argparse.Action, value: Any, key: str) -> Any:
             f"{key}: expected one of {', '.join(map(str, action.choices))}, got {value!r}"
         )
     return value
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)

@@ -8,6 +8,9 @@ from __future__ import annotations
 
 from . import essential, irls, tls
 from .base import EstimatorFit, Problem
+from .closed_loop_model import OPTIONS as CLOSED_LOOP_OPTIONS
+from .didim import didim
+from .iv import instrumental_variables
 from .registry import methods, register
 
 register(
@@ -32,6 +35,24 @@ register(
     no_physical="the physical fit estimates the standard parameters and cannot set base "
     "parameters to zero; with --physical use --method wls (the constraints and a prior fix "
     "the poorly excited directions)",
+)
+
+register(
+    "iv",
+    instrumental_variables,
+    "IDIM-IV: instruments from the closed loop simulated with the estimate (closed-loop data)",
+    CLOSED_LOOP_OPTIONS,
+    no_physical="the physical fit would weigh the measured regressor, whose noise IV's "
+    "instruments avoid; use --method wls with --physical (docs/identification.md, "
+    "'Closed-loop data')",
+)
+register(
+    "didim",
+    didim,
+    "DIDIM: the torque of the simulated closed loop fitted to the measured one (output error)",
+    CLOSED_LOOP_OPTIONS,
+    no_physical="the physical fit would weigh the measured regressor, not the simulated one "
+    "DIDIM fits; use --method wls with --physical (docs/identification.md, 'Closed-loop data')",
 )
 
 __all__ = ["EstimatorFit", "Problem", "methods", "register"]
