@@ -59,6 +59,7 @@ from .estimators.base import EstimatorFit, Problem
 from .estimators.registry import LEAST_SQUARES, estimator, method_name
 from .identify import VARIANCE_FLOOR, LeastSquaresResult
 from .physical import physical_least_squares
+from .separable import estimate_nonlinear
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
 
@@ -446,6 +447,13 @@ def identify_log(
     row_masks = [mask for mask, _ in masks]
     rows_note = masks[0][1]
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
+    # A block's nonlinear parameters (the Stribeck friction's velocity scales) are estimated
+    # first, by separable least squares, and held fixed from here on (physical fit included).
+    rigid = RigidBody(robot, bool(rotor), symmetric, base.independent)
+    separable = estimate_nonlinear(
+        rigid, blocks, runs, row_masks, method=method, exclude_joints=exclude_joints
+    )
+    blocks, block_notes = separable.blocks, block_notes + list(separable.notes)
     result = unfitted(robot, base, blocks, rotor=bool(rotor), method=method)
     result.log = prepared
     names = result.names
@@ -509,6 +517,7 @@ def identify_log(
         names=names,
         on_rank_deficient="warn" if physical else "raise",
     )
+    fit = separable.widen(fit)  # the nonlinear parameters' uncertainty in the coefficients'
     row_weights = None
     if method not in LEAST_SQUARES:  # a registered estimator, from the WLS fit
         Y_all = np.concatenate(
