@@ -111,12 +111,23 @@ def estimate_nonlinear(
     std[~np.isfinite(np.diag(cov_rho))] = np.inf
     fitted = problem.with_parameters(x, std)
     elapsed = time.perf_counter() - started
+    values = np.exp(np.clip(x, problem.lower, problem.upper))
+    estimates = ", ".join(f"{a} {v:.4g} ± {s:.2g}" for a, v, s in zip(problem.names, values, std))
     notes = [
-        f"nonlinear parameters {', '.join(problem.names)} estimated by separable least squares "
-        f"(variable projection, {'OLS' if method == 'ols' else 'WLS'} rows, {evaluations} "
-        f"evaluations, {elapsed:.2g} s); their values and standard deviations are in "
-        "result.json's options"
+        f"nonlinear parameters estimated by separable least squares (variable projection, "
+        f"{'OLS' if method == 'ols' else 'WLS'} rows, {evaluations} evaluations, "
+        f"{elapsed:.2g} s): {estimates}"
     ]
+    bound = [
+        name
+        for name, v, lo, hi in zip(problem.names, x, problem.lower, problem.upper)
+        if np.isclose(v, lo, rtol=0, atol=1e-6) or np.isclose(v, hi, rtol=0, atol=1e-6)
+    ]
+    if bound:
+        notes.append(
+            f"{', '.join(bound)} on a bound of their range (a constrained estimate: their "
+            "standard deviations are those of the unconstrained linearisation)"
+        )
     if method not in ("ols", "wls"):
         notes.append(
             "the standard deviations of the linear coefficients are those of the estimator "

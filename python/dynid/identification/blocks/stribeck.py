@@ -138,12 +138,6 @@ class StribeckFriction(Block):
     def describe(self) -> str:
         return f"{self.size} Stribeck friction coefficients (+ {2 * self.n} velocity scales)"
 
-    def notes(self) -> list[str]:
-        if not self.estimated:
-            return []
-        scales = ", ".join(f"{a:.3g}/{b:.3g}" for a, b in zip(self.vc, self.vs))
-        return [f"Stribeck friction: velocity scales vc/vs per drive (rad/s) {scales}"]
-
     # ------------------------------------------------------------------ the law
 
     def _motor(self, qd: NDArray[np.float64]) -> NDArray[np.float64]:
