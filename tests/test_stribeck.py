@@ -170,7 +170,11 @@ def test_a_coupled_wrist_is_identified_on_the_drives_velocities():
     robot = without_drive_friction(coupled_puma())
     law = truth(robot.n, 13)
     result = identify_log(
-        stribeck_log(robot, law, 2, seconds=6.0), robot, rotor=True, friction="stribeck", method="ols"
+        stribeck_log(robot, law, 2, seconds=6.0),
+        robot,
+        rotor=True,
+        friction="stribeck",
+        method="ols",
     )
     block = result.blocks[0]
     np.testing.assert_allclose(block.vc, law["vc"], rtol=1e-6)
@@ -303,7 +307,9 @@ def test_the_command_line(lwr, tmp_path, capsys):
     result = load_result(out)
     np.testing.assert_allclose(result.blocks[0].vc, law["vc"], rtol=1e-6)
     validation = tmp_path / "val"
-    assert main(["validate", str(out), str(tmp_path / "check.npz"), "--output", str(validation)]) == 0
+    assert (
+        main(["validate", str(out), str(tmp_path / "check.npz"), "--output", str(validation)]) == 0
+    )
     report = json.loads((validation / "validation.json").read_text())
     assert max(report["metrics"]["relative_rms"]) < 1e-9
     capsys.readouterr()

@@ -176,8 +176,7 @@ class _Problem:
         fixed += [b.columns(q, qd) for i, b in enumerate(blocks) if i not in self.nonlinear]
         self.F = np.concatenate(fixed, axis=2)[keep]
         # Where each group of columns sits in theta: rigid, then the blocks in order.
-        sizes = [rigid.size] + [b.size for b in blocks]
-        starts = np.cumsum([0] + sizes)
+        starts = np.cumsum([0, rigid.size, *(b.size for b in blocks)])
         fixed_index = [np.arange(rigid.size)] + [
             np.arange(starts[i + 1], starts[i + 2]) for i in range(len(blocks))
         ]
@@ -284,7 +283,7 @@ class _Problem:
         for x0 in self.starts:
             x, count = self.solve(x0, weights)
             evaluations += count
-            r, _, coefficients, D = self.evaluate(x, weights)
+            r, _, _, D = self.evaluate(x, weights)
             solutions.append((float(r @ r), x, r, D))
         acts = np.zeros((self.lower.size, self.N), dtype=bool)  # rows each parameter acts on
         for _, _, _, D in solutions:

@@ -188,14 +188,17 @@ class StribeckFriction(Block):
     def nonlinear(self) -> Nonlinear:
         n = self.n
         return Nonlinear(
-            names=tuple(f"vc{j}" for j in range(1, n + 1)) + tuple(f"vs{j}" for j in range(1, n + 1)),
+            names=tuple(f"vc{j}" for j in range(1, n + 1))
+            + tuple(f"vs{j}" for j in range(1, n + 1)),
             values=self.vc + self.vs,
             lower=(LOWER,) * 2 * n,
             upper=(UPPER,) * 2 * n,
             std=self.vc_std + self.vs_std,
             estimated=self.estimated,
-            starts=(self.vc + self.vs,)
-            + tuple((vc,) * n + (vs,) * n for vc, vs in STARTS if (vc, vs) != (START_VC, START_VS)),
+            starts=(
+                self.vc + self.vs,
+                *((vc,) * n + (vs,) * n for vc, vs in STARTS if (vc, vs) != (START_VC, START_VS)),
+            ),
         )
 
     def with_parameters(
