@@ -172,7 +172,7 @@ class _Problem:
         self.N = int(keep.sum())
         # The columns that do not change with rho, once: the base columns (one C++ batch call
         # per log) and the other blocks'.
-        fixed = [np.concatenate([rigid.columns(run.q, _velocity(run), run.qdd) for run in runs])]
+        fixed = [np.concatenate([rigid.columns(*_signals(run)) for run in runs])]
         fixed += [b.columns(q, qd) for i, b in enumerate(blocks) if i not in self.nonlinear]
         self.F = np.concatenate(fixed, axis=2)[keep]
         # Where each group of columns sits in theta: rigid, then the blocks in order.
@@ -345,8 +345,12 @@ class _Problem:
 
 
 def _velocity(run: Log) -> NDArray[np.float64]:
-    assert run.qd is not None  # identify_log's prepared logs have qd
-    return run.qd
+    return _signals(run)[1]
+
+
+def _signals(run: Log) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    assert run.qd is not None and run.qdd is not None  # identify_log's prepared logs have them
+    return run.q, run.qd, run.qdd
 
 
 def _basis(A: NDArray[np.float64]) -> NDArray[np.float64]:
