@@ -36,7 +36,6 @@ unweighted residuals at the estimate, as :func:`dynid.identify_log`'s WLS comput
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
@@ -96,7 +95,6 @@ def estimate_nonlinear(
     blocks = tuple(blocks)
     if all(b.nonlinear() is None for b in blocks):
         return Separable(blocks)
-    started = time.perf_counter()
     problem = _Problem(rigid, blocks, runs, row_masks, exclude_joints)
     unit = np.ones(problem.N)
     x, evaluations = problem.start(unit)
@@ -110,13 +108,11 @@ def estimate_nonlinear(
     std = np.sqrt(np.maximum(np.diag(cov_rho), 0.0))
     std[~np.isfinite(np.diag(cov_rho))] = np.inf
     fitted = problem.with_parameters(x, std)
-    elapsed = time.perf_counter() - started
     values = np.exp(np.clip(x, problem.lower, problem.upper))
     estimates = ", ".join(f"{a} {v:.4g} ± {s:.2g}" for a, v, s in zip(problem.names, values, std))
     notes = [
         f"nonlinear parameters estimated by separable least squares (variable projection, "
-        f"{'OLS' if method == 'ols' else 'WLS'} rows, {evaluations} evaluations, "
-        f"{elapsed:.2g} s): {estimates}"
+        f"{'OLS' if method == 'ols' else 'WLS'} rows, {evaluations} evaluations): {estimates}"
     ]
     bound = [
         name
