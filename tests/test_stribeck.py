@@ -319,3 +319,26 @@ def test_the_command_line(lwr, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--friction, --stribeck-friction: choose one friction model" in err
     assert not Path(tmp_path / "x").exists()
+
+
+def test_the_logs_regressor_is_computed_once(lwr, monkeypatch):
+    """A spy on dynid.Robot.regressor: one call on the training log's samples, shared by the
+    separable estimate of the scales and the least squares that follows."""
+    law = truth(lwr.n, 37)
+    log = stribeck_log(lwr, law, 1, seconds=3.0)
+    calls: list[int] = []
+    original = dynid.Robot.regressor
+
+    def counted(self, q, *args, **kwargs):
+        calls.append(np.shape(q)[0])
+        return original(self, q, *args, **kwargs)
+
+    monkeypatch.setattr(dynid.Robot, "regressor", counted)
+    result = identify_log(log, lwr, rotor=True, friction="stribeck", method="ols")
+    assert calls.count(log.T) == 1
+    monkeypatch.setattr(dynid.Robot, "regressor", original)
+    expected = identify_log(log, lwr, rotor=True, friction="stribeck", method="ols")
+    np.testing.assert_array_equal(
+        result.fitted, result.regressor(log.q, log.qd, log.qdd) @ result.theta
+    )
+    assert result == expected

@@ -498,6 +498,9 @@ def identify_log(
             span = slice(starts[r] + c.start, starts[r] + min(c.stop, run.T))
             return standard[span][..., selected]
         q, qd, qdd = _signals(run)
+        if separable.rigid_columns is not None:  # the base columns, computed once already
+            rigid_columns = separable.rigid_columns[r][c]
+            return np.concatenate([rigid_columns, model.extra_columns(q[c], qd[c])], axis=2)
         return model.regressor(q[c], qd[c], qdd[c])
 
     cache: dict[int, NDArray[np.float64]] = {}

@@ -65,6 +65,9 @@ class Separable:
     blocks: tuple[Block, ...]
     notes: tuple[str, ...] = ()
     added: NDArray[np.float64] | None = field(default=None, repr=False)
+    #: the base columns of each training log (T_r, n, count), computed here once, for the
+    #: least squares that follows (None without nonlinear parameters)
+    rigid_columns: tuple[NDArray[np.float64], ...] | None = field(default=None, repr=False)
 
     def widen(self, fit: LeastSquaresResult) -> LeastSquaresResult:
         """``fit`` (OLS or WLS with rho fixed at its estimate) with ``added`` in its covariance
@@ -129,7 +132,7 @@ def estimate_nonlinear(
             "the standard deviations of the linear coefficients are those of the estimator "
             "with the nonlinear parameters fixed (their own uncertainty not added)"
         )
-    return Separable(fitted, tuple(notes), added)
+    return Separable(fitted, tuple(notes), added, problem.rigid_columns)
 
 
 class _Problem:
@@ -168,7 +171,8 @@ class _Problem:
         self.N = int(keep.sum())
         # The columns that do not change with rho, once: the base columns (one C++ batch call
         # per log) and the other blocks'.
-        fixed = [np.concatenate([rigid.columns(*_signals(run)) for run in runs])]
+        self.rigid_columns = tuple(rigid.columns(*_signals(run)) for run in runs)
+        fixed = [np.concatenate(self.rigid_columns)]
         fixed += [b.columns(q, qd) for i, b in enumerate(blocks) if i not in self.nonlinear]
         self.F = np.concatenate(fixed, axis=2)[keep]
         # Where each group of columns sits in theta: rigid, then the blocks in order.
