@@ -387,7 +387,10 @@ def identify_log(
     columns; ``friction`` the friction model: False ("none"), True or "symmetric" (Fv qd +
     Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a coefficient per direction
     of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
-    Coulomb asymmetry: :mod:`dynid.identification.friction_models`). ``offset`` adds one constant
+    Coulomb asymmetry: :mod:`dynid.identification.friction_models`), or "stribeck" (smooth
+    Stribeck friction per drive and direction, whose velocity scales are estimated first by
+    separable least squares and then held fixed: :mod:`dynid.identification.blocks.stribeck`,
+    :mod:`dynid.identification.separable`). ``offset`` adds one constant
     torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
     these two columns are structurally identifiable next to the others
     (:func:`dynid.identification.position_torque.position_torque_joints`; the joints left out are
