@@ -7,7 +7,8 @@ Apache-2.0, re-packed unchanged as the keys ``motor_position``, ``motor_torque``
 ``sample_time`` 2e-4) and, for FIGAROH's rows, ``figaroh_1.0.2_heldout_predictions.npz`` (its
 held-out predictions, ``pred_asis`` and ``pred_coupled``, samples 29270:44980)::
 
-    python examples/staubli_tx40_heldout.py DATA_DIR [--output DIR] [--options "..."] [-- EXTRA]
+    python examples/staubli_tx40_heldout.py DATA_DIR [--output DIR] [--options "..."]
+                                            [--friction-model symmetric|stribeck] [-- EXTRA]
 
 What it does, as a user would:
 
@@ -24,7 +25,9 @@ What it does, as a user would:
    log's decimated rate is compared sample by sample).
 
 It prints the table with FIGAROH's rows (recomputed from its shipped predictions with the same
-yardstick) and writes ``heldout.json`` into the output folder. Extra options after ``--`` go to
+yardstick) and writes ``heldout.json`` into the output folder. ``--friction-model stribeck``
+puts ``--stribeck-friction`` (docs/identification.md, "Smooth Stribeck friction") in place of
+``--friction`` in the options. Extra options after ``--`` go to
 ``dynid identify`` (e.g. ``-- --skip-end 50`` once that option exists).
 """
 
@@ -61,6 +64,10 @@ OPTIONS = [
     "--rest-velocity",
     "auto",
 ]
+
+#: --friction-model: the dynid identify flag of each friction model (coupled wrist: the
+#: asymmetric model, which acts on each joint's velocity, refuses it).
+FRICTION_FLAGS = {"symmetric": "--friction", "stribeck": "--stribeck-friction"}
 
 
 def relative_rms(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:
@@ -185,8 +192,18 @@ def main() -> None:
         default=" ".join(OPTIONS),
         help=f"the model and preparation options of dynid identify (default {' '.join(OPTIONS)!r})",
     )
+    parser.add_argument(
+        "--friction-model",
+        choices=FRICTION_FLAGS,
+        default="symmetric",
+        help="the friction model: the flag put in place of --friction in the options",
+    )
     args = parser.parse_args(argv)
-    table = run(args.data_dir, args.output, extra, args.options.split())
+    options = [
+        FRICTION_FLAGS[args.friction_model] if o == "--friction" else o
+        for o in args.options.split()
+    ]
+    table = run(args.data_dir, args.output, extra, options)
     print(
         f"\nheld-out relative RMS (%), samples {SCORED[0]}:{SCORED[1]} ({table['samples scored']})"
     )

@@ -140,8 +140,8 @@ def test_a_registered_friction_block_is_constrained_in_the_physical_fit(smooth, 
 
 def test_unknown_friction_models_name_the_registered_ones(smooth, lwr):
     log = smooth_log(lwr, 1)
-    with pytest.raises(ValueError, match=r"friction: .*'smooth'.*got 'stribeck'"):
-        identify_log(log, lwr, friction="stribeck")
+    with pytest.raises(ValueError, match=r"friction: .*'smooth'.*got 'lugre'"):
+        identify_log(log, lwr, friction="lugre")
 
 
 def test_the_model_gives_every_block_its_slice(lwr):

@@ -187,8 +187,7 @@ def _identify(args: argparse.Namespace, seen: list[str]) -> None:
         raise ValueError(f"--method {args.method}: only with --current (motor currents)")
     if not args.physical and (args.prior is not None or args.prior_weight is not None):
         raise ValueError("--prior, --prior-weight: only with --physical")
-    if args.friction and args.asymmetric_friction:
-        raise ValueError("--friction, --asymmetric-friction: choose one friction model")
+    friction = friction_option(args)
     step = _steps(5)
     robot = load_robot(args, args.model)  # first: a ROS bag's joints are matched to its names
     logs = [load_log_of(args, robot.joint_names, path) for path in args.log]
@@ -210,7 +209,7 @@ def _identify(args: argparse.Namespace, seen: list[str]) -> None:
         logs if len(logs) > 1 else logs[0],
         robot,
         rotor=args.rotor,
-        friction="asymmetric" if args.asymmetric_friction else args.friction,
+        friction=friction,
         offset=args.offset,
         method=method,
         preparation=preparation_options(args),
@@ -243,6 +242,24 @@ def _identify(args: argparse.Namespace, seen: list[str]) -> None:
         + (" (and per log)" if len(logs) > 1 else "")
         + _report_written(args, path)
     )
+
+
+def friction_option(args: argparse.Namespace) -> bool | str:
+    """``friction`` of identify_log from --friction, --asymmetric-friction and
+    --stribeck-friction (at most one of them)."""
+    flags = {
+        "--friction": args.friction,
+        "--asymmetric-friction": args.asymmetric_friction,
+        "--stribeck-friction": getattr(args, "stribeck_friction", False),
+    }
+    chosen = [flag for flag, on in flags.items() if on]
+    if len(chosen) > 1:
+        raise ValueError(f"{', '.join(chosen)}: choose one friction model")
+    if args.asymmetric_friction:
+        return "asymmetric"
+    if getattr(args, "stribeck_friction", False):
+        return "stribeck"
+    return bool(args.friction)
 
 
 def _resolved_prior(result: Any) -> dict[str, Any]:
@@ -331,8 +348,7 @@ def identify_from_currents(args: argparse.Namespace, seen: list[str] | None = No
 
     if args.physical or args.prior is not None:
         raise ValueError("--current: not with --physical or --prior")
-    if args.friction and args.asymmetric_friction:
-        raise ValueError("--friction, --asymmetric-friction: choose one friction model")
+    friction = friction_option(args)
     if args.payload_log is None:
         raise ValueError(
             "--current: needs --payload-log LOG, a run with a known payload: currents fix the "
@@ -357,7 +373,7 @@ def identify_from_currents(args: argparse.Namespace, seen: list[str] | None = No
         payload=payload,
         payload_mass=args.payload_mass,
         rotor=args.rotor,
-        friction="asymmetric" if args.asymmetric_friction else args.friction,
+        friction=friction,
         offset=args.offset,
         position_torque=args.position_torque,
         method=args.method or "nls",

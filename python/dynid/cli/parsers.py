@@ -72,6 +72,14 @@ def _add_identify(subcommands: Any) -> None:
         "--friction's Fv, Fs (docs/identification.md)",
     )
     p.add_argument(
+        "--stribeck-friction",
+        action="store_true",
+        help="smooth Stribeck friction per drive and direction, [Fc (1 - e) + Fst e] "
+        "tanh(w/vc) + Fv w with e = exp(-(w/vs)^2), its velocity scales vc, vs estimated on "
+        "the log (separable least squares), instead of --friction's Fv, Fs "
+        "(docs/identification.md)",
+    )
+    p.add_argument(
         "--offset", action="store_true", help="add a constant torque (sensor offset) per joint"
     )
     p.add_argument(

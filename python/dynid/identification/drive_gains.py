@@ -218,6 +218,11 @@ def identify_drive_gains(
     # The torque model: the base parameters, then the column blocks these options ask for
     # (dynid.identification.blocks), as in identify_log.
     built = build_blocks(Context(robot, rotor, kind, offset, position_torque))
+    if any(block.nonlinear() is not None for block in built):  # e.g. Stribeck's velocity scales
+        raise ValueError(
+            f"friction: the {kind!r} model has nonlinear parameters, which identify_log "
+            "estimates (separable least squares) and identify_drive_gains does not"
+        )
     column_blocks = kept(built)
     result = unfitted(robot, base, column_blocks, rotor=rotor, method=method)
     names = result.names

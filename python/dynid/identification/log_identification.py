@@ -59,6 +59,7 @@ from .estimators.base import EstimatorFit, Problem
 from .estimators.registry import LEAST_SQUARES, estimator, method_name
 from .identify import VARIANCE_FLOOR, LeastSquaresResult, relative_std
 from .physical import physical_least_squares
+from .separable import estimate_nonlinear
 from .serial_correlation import (
     WIDTH_PER_WINDOW,
     LongRunAccumulator,
@@ -396,7 +397,10 @@ def identify_log(
     columns; ``friction`` the friction model: False ("none"), True or "symmetric" (Fv qd +
     Fs sign(qd)), or "asymmetric" (Fv+, Fv-, Fs+, Fs- per joint, a coefficient per direction
     of motion; with ``offset`` Fv+, Fv-, Fs, the offset carrying the
-    Coulomb asymmetry: :mod:`dynid.identification.friction_models`). ``offset`` adds one constant
+    Coulomb asymmetry: :mod:`dynid.identification.friction_models`), or "stribeck" (smooth
+    Stribeck friction per drive and direction, whose velocity scales are estimated first by
+    separable least squares and then held fixed: :mod:`dynid.identification.blocks.stribeck`,
+    :mod:`dynid.identification.separable`). ``offset`` adds one constant
     torque per joint. ``position_torque`` adds ks_j sin q_j + kc_j cos q_j on every joint where
     these two columns are structurally identifiable next to the others
     (:func:`dynid.identification.position_torque.position_torque_joints`; the joints left out are
@@ -458,6 +462,13 @@ def identify_log(
     row_masks = [mask for mask, _ in masks]
     rows_note = masks[0][1]
     base = base_parameters(robot, "torque", rotor=bool(rotor), friction=symmetric)
+    # A block's nonlinear parameters (the Stribeck friction's velocity scales) are estimated
+    # first, by separable least squares, and held fixed from here on (physical fit included).
+    rigid = RigidBody(robot, bool(rotor), symmetric, base.independent)
+    separable = estimate_nonlinear(
+        rigid, blocks, runs, row_masks, method=method, exclude_joints=exclude_joints
+    )
+    blocks, block_notes = separable.blocks, block_notes + list(separable.notes)
     result = unfitted(robot, base, blocks, rotor=bool(rotor), method=method)
     result.log = prepared
     names = result.names
@@ -502,6 +513,9 @@ def identify_log(
             span = slice(starts[r] + c.start, starts[r] + min(c.stop, run.T))
             return standard[span][..., selected]
         q, qd, qdd = _signals(run)
+        if separable.rigid_columns is not None:  # the base columns, computed once already
+            rigid_columns = separable.rigid_columns[r][c]
+            return np.concatenate([rigid_columns, model.extra_columns(q[c], qd[c])], axis=2)
         return model.regressor(q[c], qd[c], qdd[c])
 
     cache: dict[int, NDArray[np.float64]] = {}
@@ -521,6 +535,7 @@ def identify_log(
         names=names,
         on_rank_deficient="warn" if physical else "raise",
     )
+    fit = separable.widen(fit)  # the nonlinear parameters' uncertainty in the coefficients'
     row_weights = None
     if method not in LEAST_SQUARES:  # a registered estimator, from the WLS fit
         Y_all = np.concatenate(
@@ -572,6 +587,7 @@ def identify_log(
             [(r, c, cache.get(i)) for i, (r, c) in enumerate(chunks)],
             chunk_regressor,
             fitted,
+            separable.added,
         )
     plain = {k: _plain(v) for k, v in options.items()}
     if len(runs) == 1:
@@ -627,12 +643,15 @@ def _correlation_robust_std(
     chunks: Sequence[tuple[int, slice, NDArray[np.float64] | None]],
     regressor: Any,
     fitted: NDArray[np.float64],
+    added: NDArray[np.float64] | None = None,
 ) -> list[str]:
     """Replace the least-squares standard deviations in ``result`` by those of the residuals'
     correlation in time (the sandwich A^-1 Omega A^-1 of dynid.identification.
     serial_correlation, Omega by the Bartlett kernel of the width the residuals show) when the
     residuals are correlated (width > 1); the note that says so, or none. ``chunks``: (log,
-    samples, its regressor or None to compute it with ``regressor(log, samples)``)."""
+    samples, its regressor or None to compute it with ``regressor(log, samples)``). ``added``:
+    the covariance a block's nonlinear parameters add (dynid.identification.separable: the
+    Stribeck velocity scales' uncertainty, from their own fit), kept on top of the sandwich."""
     covariance = fit.covariance
     if covariance is None or not np.all(np.isfinite(covariance)) or fit.rank < result.theta.size:
         return []
@@ -684,7 +703,7 @@ def _correlation_robust_std(
             residual = np.where(rows[c], residual, 0.0)
         accumulator.add(np.einsum("tjp,tj->tp", WY, residual) @ inverse.T)
     accumulator.end_segment()
-    robust = accumulator.omega
+    robust = accumulator.omega if added is None else accumulator.omega + added
     std = np.sqrt(np.maximum(np.diag(robust), 0.0))
     ratio = std / np.where(result.std > 0, result.std, np.inf)
     result.covariance, result.std = robust, std

@@ -12,6 +12,13 @@ each its slice of theta, so no other code computes where a coefficient sits.
 
 Adding a block (e.g. a friction model): one file with a subclass of :class:`Block` and one
 ``register(...)`` line in :mod:`.registry` (docs/identification.md, "Column blocks").
+
+A block whose columns also depend on parameters that enter them nonlinearly (a friction law's
+velocity scales) says so through :meth:`Block.nonlinear` (their names, values, bounds and
+standard deviations) and gives :meth:`Block.with_parameters` and
+:meth:`Block.torque_derivatives`; :func:`dynid.identify_log` then estimates them first by
+separable least squares (:mod:`dynid.identification.separable`) and fits the linear
+coefficients with them fixed.
 """
 
 from __future__ import annotations
@@ -25,6 +32,26 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...model.robot import Robot
+
+
+@dataclass(frozen=True)
+class Nonlinear:
+    """A block's parameters that enter its columns nonlinearly (e.g. velocity scales), in their
+    units, each positive and within its bounds. ``std`` is inf until they are estimated (and
+    where the data do not determine them)."""
+
+    names: tuple[str, ...]
+    values: tuple[float, ...]
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    std: tuple[float, ...]
+    estimated: bool  #: whether ``values`` are an estimate on data (False: the starting values)
+    #: starting values for the estimate (each like ``values``; the estimate tries them all)
+    starts: tuple[tuple[float, ...], ...] = ()
+
+    @property
+    def size(self) -> int:
+        return len(self.names)
 
 
 @dataclass(frozen=True)
@@ -96,6 +123,29 @@ class Block(ABC):
     def describe(self) -> str:
         """The block in the summary's list of coefficients, e.g. "7 offsets"."""
         return f"{self.size} {self.key.replace('_', ' ')} coefficients"
+
+    # The optional nonlinear part (module docstring): blocks without one keep these defaults.
+
+    def nonlinear(self) -> Nonlinear | None:
+        """The parameters that enter the columns nonlinearly; None (the default) when the
+        columns are functions of q and qd alone."""
+        return None
+
+    def with_parameters(self, values: NDArray[np.float64], std: NDArray[np.float64]) -> Block:
+        """The same block with its nonlinear parameters set to ``values`` (estimated, with
+        standard deviations ``std``), both in the order of ``nonlinear().names``."""
+        raise NotImplementedError(f"block {self.key!r} has no nonlinear parameters")
+
+    def torque_derivatives(
+        self,
+        q: NDArray[np.float64],
+        qd: NDArray[np.float64],
+        coefficients: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        """(k, T, n) the derivatives of the block's torque ``columns(q, qd) @ coefficients``
+        with respect to the logarithms of its k nonlinear parameters (v d/dv), at their
+        current values (the Jacobian of the separable fit, :mod:`..separable`)."""
+        raise NotImplementedError(f"block {self.key!r} has no nonlinear parameters")
 
 
 class MeasurementBlock(ABC):

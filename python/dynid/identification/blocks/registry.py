@@ -16,6 +16,7 @@ from .base import Block, Context
 from .friction import AsymmetricFriction
 from .offset import Offset
 from .position_torque import PositionTorque
+from .stribeck import StribeckFriction
 
 #: The blocks by name, in the order of their columns in theta.
 REGISTRY: dict[str, type[Block]] = {}
@@ -74,5 +75,6 @@ def blocks_from_record(options: Mapping[str, Any], n: int) -> list[Block]:
 
 
 register(AsymmetricFriction)
+register(StribeckFriction)
 register(Offset)
 register(PositionTorque)
