@@ -7,6 +7,15 @@ Each is a function ``(Problem) -> EstimatorFit`` (:mod:`.base`) in a file of its
 from __future__ import annotations
 
 from .base import EstimatorFit, Problem
+from .periodic import periodic
 from .registry import methods, register
+
+register(
+    "periodic",
+    periodic,
+    "periodic-data ML (Swevers et al. 1997): whole periods averaged, weighted by the noise of "
+    "their scatter",
+    options=("period",),
+)
 
 __all__ = ["EstimatorFit", "Problem", "methods", "register"]
