@@ -107,6 +107,7 @@ def _add_identify(subcommands: Any) -> None:
     _add_current(p)
     _add_preparation(p)
     _add_motor_side(p)
+    _add_periodic(p)
     _add_output(p, "dynid-identify")
     p.set_defaults(run=commands.identify)
 
@@ -353,6 +354,17 @@ def _add_motor_side(p: argparse.ArgumentParser) -> None:
         "model's gear_ratios, transmission and joint_offsets, q = R^-1 theta - joint_offsets, "
         "tau = R^T tau_m, R = diag(gear_ratios) T (docs/data.md); validate applies it by itself "
         "to a result trained on a motor-side log, --no-motor-side reads LOG as joint side",
+    )
+
+
+def _add_periodic(p: argparse.ArgumentParser) -> None:
+    """The options of --method periodic (dynid.identification.estimators.periodic)."""
+    p.add_argument(
+        "--period",
+        type=float,
+        metavar="S",
+        help="with --method periodic: the trajectory's period in s (default: found from the "
+        "autocorrelation of q; a log that does not repeat twice is refused)",
     )
 
 

@@ -40,6 +40,10 @@ from .period import MIN_CORRELATION, detect_period, period_starts
 #: null (the tolerance of dynid.least_squares).
 RANK_TOLERANCE = 1e-10
 
+#: A joint whose period-to-period scatter is below this fraction of its RMS torque repeats
+#: exactly (a simulated log without noise): refused, there is no noise level to weigh by.
+EXACT = 1e-10
+
 #: A log whose sample times vary by more than this fraction of the median step is refused: a
 #: period is a number of samples.
 TIME_JITTER = 0.05
@@ -74,8 +78,10 @@ def periodic(problem: Problem) -> EstimatorFit:
     dof = sum(a.dof for a in logs)
     Sigma = sum(a.scatter for a in logs)[np.ix_(joints, joints)] / dof
     variance = np.diag(Sigma).copy()
-    if not np.all(variance > 0):
-        zero = [j + 1 for j, v in zip(joints, variance) if not v > 0]
+    # Rounding alone differs by ~1e-16 of the torque between periods: no noise to weigh by.
+    size = np.sqrt(np.mean(np.concatenate([a.tau[:, joints] for a in logs]) ** 2, axis=0))
+    if not np.all(variance > (EXACT * size) ** 2):
+        zero = [j + 1 for j, v, s in zip(joints, variance, size) if not v > (EXACT * s) ** 2]
         raise ValueError(
             f"period: the torques of joints {zero} repeat exactly from period to period: no "
             "noise to estimate (a simulated log without noise?); use method 'wls'"
