@@ -44,9 +44,9 @@ RANK_TOLERANCE = 1e-10
 #: exactly (a simulated log without noise): refused, there is no noise level to weigh by.
 EXACT = 1e-10
 
-#: A log whose sample times vary by more than this fraction of the median step is refused: a
-#: period is a number of samples.
-TIME_JITTER = 0.05
+#: A log whose sample k is further than this many steps from t0 + k dt (dt the mean step) is
+#: refused: a period is a number of samples.
+TIME_DRIFT = 0.5
 
 
 @dataclass(frozen=True)
@@ -143,13 +143,15 @@ def _average(problem: Problem, k: int, period: float | None) -> Averaged:
     log = problem.runs[k]
     label = f"log {k + 1}" + (f" ({log.source})" if log.source else "")
     T = log.t.size
-    steps = np.diff(log.t)
-    dt = float(np.median(steps))
-    if np.max(np.abs(steps - dt)) > TIME_JITTER * dt:
+    # A period is a number of samples: sample k must be at t0 + k dt to within half a step
+    # (a jittery clock is fine, a drifting or gapped one is not).
+    dt = float(log.t[-1] - log.t[0]) / (T - 1)
+    drift = float(np.max(np.abs(log.t - log.t[0] - dt * np.arange(T))))
+    if drift > TIME_DRIFT * dt:
         raise ValueError(
-            f"period: {label} has sample times varying by up to "
-            f"{np.max(np.abs(steps - dt)) / dt:.0%} of its step: resample it to a uniform time "
-            "base (the default preparation) before method 'periodic'"
+            f"period: {label}'s sample k is up to {drift / dt:.2g} steps away from t0 + k dt: "
+            "resample it to a uniform time base (the default preparation) before method "
+            "'periodic'"
         )
     if period is None:
         found = detect_period(log.q)
