@@ -159,21 +159,17 @@ def test_non_periodic_and_short_logs_are_refused(lwr, exact):
             noisy(short, 0), lwr, rotor=True, friction=True, method="periodic",
             estimator_options={"period": PERIOD},
         )  # fmt: skip
-    with pytest.raises(ValueError, match="period: the torques of joints .* repeat exactly"):
+    with pytest.raises(ValueError, match=r"period: the torques of joints .* repeat exactly"):
         identify_log(exact, lwr, rotor=True, friction=True, method="periodic")
     with pytest.raises(ValueError, match="period: expected a positive"):
-        identify_log(
-            noisy(exact, 0), lwr, method="periodic", estimator_options={"period": -1.0}
-        )
+        identify_log(noisy(exact, 0), lwr, method="periodic", estimator_options={"period": -1.0})
     gap = noisy(exact, 0)
     gap = Log(t=np.where(gap.t < 10, gap.t, gap.t + 0.5), q=gap.q, qd=gap.qd, qdd=gap.qdd,
               tau=gap.tau)  # fmt: skip
     with pytest.raises(ValueError, match=r"period: log 1's sample k is up to 2\d steps away"):
         identify_log(gap, lwr, method="periodic")
     with pytest.raises(ValueError, match="min_velocity: method 'periodic'"):
-        identify_log(
-            noisy(exact, 0), lwr, method="periodic", preparation={"min_velocity": 0.05}
-        )
+        identify_log(noisy(exact, 0), lwr, method="periodic", preparation={"min_velocity": 0.05})
 
 
 def test_cli_period_flag(lwr, exact, tmp_path, capsys):

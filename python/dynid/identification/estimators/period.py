@@ -62,6 +62,6 @@ def period_starts(length: int, period: float) -> NDArray[np.int64]:
     sample out of phase (no drift over the periods)."""
     K = int(period)
     count = 0
-    while int(round(count * period)) + K <= length:
+    while round(count * period) + K <= length:
         count += 1
-    return np.array([int(round(m * period)) for m in range(count)], dtype=np.int64)
+    return np.array([round(m * period) for m in range(count)], dtype=np.int64)

@@ -76,7 +76,7 @@ def periodic(problem: Problem) -> EstimatorFit:
         )
     logs = [_average(problem, k, period) for k in range(len(problem.runs))]
     dof = sum(a.dof for a in logs)
-    Sigma = sum(a.scatter for a in logs)[np.ix_(joints, joints)] / dof
+    Sigma = np.sum([a.scatter for a in logs], axis=0)[np.ix_(joints, joints)] / dof
     variance = np.diag(Sigma).copy()
     # Rounding alone differs by ~1e-16 of the torque between periods: no noise to weigh by.
     size = np.sqrt(np.mean(np.concatenate([a.tau[:, joints] for a in logs]) ** 2, axis=0))
