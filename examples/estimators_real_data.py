@@ -228,7 +228,8 @@ def markdown(rows: list[dict[str, Any]], peers: dict[str, Any], check: dict[str,
         for r in subset:
             if r["relative_rms_percent"] is None:
                 # "period: log 1 (path) is not periodic: ...; ..." -> "log 1 is not periodic"
-                why = re.sub(r" \(.*?\)", "", r["refused"]).split(": ")[1].replace("|", "/")
+                why = re.sub(r" \(.*?\)", "", r["refused"]).split(": ")[1].split(";")[0]
+                why = why.replace("|", "/")
                 cells = f"refused: {why} |" + " |" * n
             else:
                 values = r["relative_rms_percent"]

@@ -153,12 +153,13 @@ def test_non_periodic_and_short_logs_are_refused(lwr, exact):
     chirp = Log(t=t, q=q, qd=qd, qdd=qdd, tau=lwr.rnea(q, qd, qdd) + rng.normal(size=q.shape))
     with pytest.raises(ValueError, match=r"period: log 1 is not periodic: the autocorrelation"):
         identify_log(chirp, lwr, rotor=True, friction=True, method="periodic")
-    short = fourier_log(lwr, 1, seconds=1.8 * PERIOD)
-    with pytest.raises(ValueError, match=r"holds 1\.80 periods of 5 s; .* at least 2 whole"):
-        identify_log(
-            noisy(short, 0), lwr, rotor=True, friction=True, method="periodic",
-            estimator_options={"period": PERIOD},
-        )  # fmt: skip
+    short = noisy(fourier_log(lwr, 1, seconds=1.8 * PERIOD), 0)
+    for options in ({"period": PERIOD}, None):  # given, and found (the log repeats once)
+        with pytest.raises(ValueError, match=r"holds 1\.80 periods of 5 s; .* at least 2 whole"):
+            identify_log(
+                short, lwr, rotor=True, friction=True, method="periodic",
+                estimator_options=options,
+            )  # fmt: skip
     with pytest.raises(ValueError, match=r"period: the torques of joints .* repeat exactly"):
         identify_log(exact, lwr, rotor=True, friction=True, method="periodic")
     with pytest.raises(ValueError, match="period: expected a positive"):

@@ -364,7 +364,7 @@ def _add_periodic(p: argparse.ArgumentParser) -> None:
         type=float,
         metavar="S",
         help="with --method periodic: the trajectory's period in s (default: found from the "
-        "autocorrelation of q; a log that does not repeat twice is refused)",
+        "autocorrelation of q; fewer than two whole periods are refused)",
     )
 
 

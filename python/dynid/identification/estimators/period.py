@@ -5,8 +5,10 @@ positions repeat after ``L`` samples has ``q(t + L) = q(t)``: the normalised cor
 ``q - mean(q)`` with itself shifted by ``L`` samples (every joint summed, over the samples both
 copies cover) is 1 there, and 1 - O(noise / motion) on a measured log. The period is the
 first lag after the correlation has fallen below zero at which it climbs back above
-:data:`MIN_CORRELATION`, moved to the nearest local maximum; a log with no such lag within
-half its length (fewer than two periods) is refused.
+:data:`MIN_CORRELATION`, moved to the nearest local maximum. Lags are searched while the two
+copies overlap by at least :data:`MIN_OVERLAP` of the log (a few samples correlate trivially),
+so a log of 1.5-2 periods has its period found, and the estimator then says that it holds fewer
+than two; a log with no such lag is not periodic.
 """
 
 from __future__ import annotations
@@ -17,6 +19,11 @@ from numpy.typing import NDArray
 #: The autocorrelation of q at a period: 1 for an exactly periodic motion; the LWR4+ logs give
 #: 0.9999 at their 12.57 s period, a random walk or a chirp nowhere more than ~0.5.
 MIN_CORRELATION = 0.98
+
+
+#: The shortest overlap of the log with its shifted copy at which a lag is considered, as a
+#: fraction of the log's length.
+MIN_OVERLAP = 1 / 3
 
 
 def autocorrelation(q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -39,18 +46,18 @@ def autocorrelation(q: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def detect_period(q: NDArray[np.float64]) -> tuple[int, float] | None:
     """(period in samples, correlation there) of the positions ``q`` (T, n), or None when they
-    do not repeat at least twice (see the module's docstring)."""
+    do not repeat (see the module's docstring)."""
     r = autocorrelation(q)
-    half = q.shape[0] // 2
-    below = np.flatnonzero(r[1 : half + 1] < 0.0)
+    last = int(q.shape[0] * (1 - MIN_OVERLAP))
+    below = np.flatnonzero(r[1 : last + 1] < 0.0)
     if below.size == 0:
         return None
     start = int(below[0]) + 1
-    above = np.flatnonzero(r[start : half + 1] >= MIN_CORRELATION)
+    above = np.flatnonzero(r[start : last + 1] >= MIN_CORRELATION)
     if above.size == 0:
         return None
     lag = start + int(above[0])
-    while lag + 1 <= half and r[lag + 1] > r[lag]:
+    while lag + 1 <= last and r[lag + 1] > r[lag]:
         lag += 1
     return lag, float(r[lag])
 

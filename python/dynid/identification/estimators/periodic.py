@@ -158,9 +158,8 @@ def _average(problem: Problem, k: int, period: float | None) -> Averaged:
         if found is None:
             raise ValueError(
                 f"period: {label} is not periodic: the autocorrelation of q never comes back "
-                f"above {MIN_CORRELATION} within half the log ({T * dt:.3g} s), so it holds no "
-                "two periods of one motion; give the period (--period, in s) if it is periodic, "
-                "or use another method"
+                f"above {MIN_CORRELATION} within the log ({T * dt:.3g} s); give the period "
+                "(--period, in s) if it is periodic, or use another method"
             )
         samples, correlation = float(found[0]), found[1]
     else:
