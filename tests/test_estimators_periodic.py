@@ -210,3 +210,23 @@ def test_the_real_lwr4_logs(lwr):
     np.testing.assert_allclose(got, documented, rtol=0.05)
     assert fit.estimator["logs"][0]["periods"] == 2
     assert fit.estimator["noise_std"][1] == pytest.approx(2.34, rel=0.05)
+
+
+def test_a_direction_no_period_excites_has_infinite_std():
+    """The averaged system's solver (periodic._solve) on a matrix with two equal columns:
+    rank p - 1, the minimum-norm estimate (the two share the coefficient equally, as numpy's
+    lstsq gives), infinite std on those two and the others' (A^T A)^-1 as the full-rank
+    system without the duplicate."""
+    from dynid.identification.estimators.periodic import _solve
+
+    rng = np.random.default_rng(2)
+    B = rng.normal(size=(200, 3))
+    A = np.column_stack([B, B[:, 2]])
+    b = B @ [1.0, 2.0, 3.0] + 0.01 * rng.normal(size=200)
+    theta, inverse, rank, _, free = _solve(A, b)
+    assert rank == 3 and free.tolist() == [False, False, True, True]
+    expected, *_ = np.linalg.lstsq(A, b, rcond=None)
+    np.testing.assert_allclose(theta, expected, rtol=1e-12)
+    # columns 0, 1 are orthogonal to the null direction (0, 0, 1, -1): their block of the
+    # pseudo-inverse is that of the system with the duplicate removed
+    np.testing.assert_allclose(inverse[:2, :2], np.linalg.inv(B.T @ B)[:2, :2], rtol=1e-10)

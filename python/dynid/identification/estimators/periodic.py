@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import _checks as checks
-from ..identify import LeastSquaresResult, relative_std
+from ..identify import IDENTIFIABLE_TOLERANCE, LeastSquaresResult, relative_std
 from .base import EstimatorFit, Problem
 from .period import MIN_CORRELATION, detect_period, period_starts
 
@@ -90,10 +90,11 @@ def periodic(problem: Problem) -> EstimatorFit:
     # Rows of joint j in log k divided by sigma_j / sqrt(M_k): unit noise variance each.
     A = np.concatenate([a.Y[:, joints, :] * (np.sqrt(a.periods) / sigma)[:, None] for a in logs])
     b = np.concatenate([a.tau[:, joints] * (np.sqrt(a.periods) / sigma) for a in logs])
-    theta, inverse, rank, condition = _solve(A.reshape(-1, problem.p), b.reshape(-1))
+    theta, inverse, rank, condition, free = _solve(A.reshape(-1, problem.p), b.reshape(-1))
     correlation = Sigma / np.outer(sigma, sigma)
     middle = np.einsum("kip,ij,kjq->pq", A, correlation, A)
     covariance = inverse @ middle @ inverse
+    covariance[free, :] = covariance[:, free] = np.inf  # as dynid.least_squares: not identified
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     residual = b - A @ theta  # (samples, joints), unit variance each if the model is right
     rows = residual.size
@@ -202,16 +203,18 @@ def _average(problem: Problem, k: int, period: float | None) -> Averaged:
 
 def _solve(
     A: NDArray[np.float64], b: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64], int, float]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], int, float, NDArray[np.bool_]]:
     """theta = A^# b by the SVD of the column-scaled A (truncated at RANK_TOLERANCE), with
-    (A^T A)^-1 (the pseudo-inverse when rank deficient), the rank and cond(A)."""
+    (A^T A)^-1 (the pseudo-inverse when rank deficient), the rank, cond(A) and the parameters
+    that enter a null direction (entry above IDENTIFIABLE_TOLERANCE, as dynid.least_squares)."""
     norms = np.linalg.norm(A, axis=0)
     norms[norms == 0] = 1.0
     U, s, Vt = np.linalg.svd(A / norms, full_matrices=False)
     rank = int(np.sum(s > RANK_TOLERANCE * s[0]))
+    free = np.abs(Vt[rank:]).max(axis=0, initial=0.0) > IDENTIFIABLE_TOLERANCE
     U, s, Vt = U[:, :rank], s[:rank], Vt[:rank]
     theta = (Vt.T @ ((U.T @ b) / s)) / norms
     inverse = ((Vt.T / s**2) @ Vt) / np.outer(norms, norms)
     singular = np.linalg.svd(A, compute_uv=False)
     condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else float("inf")
-    return theta, inverse, rank, condition
+    return theta, inverse, rank, condition, free
