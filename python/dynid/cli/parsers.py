@@ -120,6 +120,7 @@ def _add_identify(subcommands: Any) -> None:
     _add_closed_loop_estimators(p)
     _add_preparation(p)
     _add_motor_side(p)
+    _add_periodic(p)
     _add_output(p, "dynid-identify")
     _add_report(p)
     p.set_defaults(run=commands.identify)
@@ -700,6 +701,17 @@ def _add_robust_estimators(p: argparse.ArgumentParser) -> None:
         metavar="PERCENT",
         help="--method essential: remove coefficients whose relative standard deviation is "
         "above this, one at a time while the fit holds (default 10)",
+    )
+
+
+def _add_periodic(p: argparse.ArgumentParser) -> None:
+    """The options of --method periodic (dynid.identification.estimators.periodic)."""
+    p.add_argument(
+        "--period",
+        type=float,
+        metavar="S",
+        help="with --method periodic: the trajectory's period in s (default: found from the "
+        "autocorrelation of q; fewer than two whole periods are refused)",
     )
 
 

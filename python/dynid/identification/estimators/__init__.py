@@ -11,6 +11,7 @@ from .base import EstimatorFit, Problem
 from .closed_loop_model import OPTIONS as CLOSED_LOOP_OPTIONS
 from .didim import didim
 from .iv import instrumental_variables
+from .periodic import periodic
 from .registry import methods, register
 
 register(
@@ -53,6 +54,13 @@ register(
     CLOSED_LOOP_OPTIONS,
     no_physical="the physical fit would weigh the measured regressor, not the simulated one "
     "DIDIM fits; use --method wls with --physical (docs/identification.md, 'Closed-loop data')",
+)
+register(
+    "periodic",
+    periodic,
+    "periodic-data ML (Swevers et al. 1997): whole periods averaged, weighted by the noise of "
+    "their scatter",
+    options=("period",),
 )
 
 __all__ = ["EstimatorFit", "Problem", "methods", "register"]
