@@ -29,6 +29,7 @@ from .trajectory import (
     DEFAULT_QDD_MAX,
     FourierTrajectory,
     _basis,
+    _basis_states,
     _extents,
     _finite_array,
     _finite_positive,
@@ -266,10 +267,7 @@ class _LogCondition:
         self._x: NDArray[np.float64] | None = None
 
     def _states(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
-        nh = self.n * self.harmonics
-        c = np.hstack([x[:nh].reshape(self.n, -1), x[nh : 2 * nh].reshape(self.n, -1)])
-        Bq, Bqd, Bqdd = self.basis
-        return Bq @ c.T + x[2 * nh :], Bqd @ c.T, Bqdd @ c.T
+        return _basis_states(x, self.n, self.harmonics, self.basis)
 
     def _regressor(self, q: NDArray, qd: NDArray, qdd: NDArray) -> NDArray[np.float64]:
         return self.robot.regressor(q, qd, qdd, rotor=self.rotor, friction=self.friction)

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _core
-from .trajectory import FourierTrajectory, _basis, _extents, _finite_array
+from .trajectory import FourierTrajectory, _basis, _basis_states, _extents, _finite_array
 
 if TYPE_CHECKING:
     from ..model.robot import Robot
@@ -68,10 +68,7 @@ class TorqueConstraint:
         self._x: NDArray[np.float64] | None = None
 
     def _states(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
-        nh = self.n * self.harmonics
-        c = np.hstack([x[:nh].reshape(self.n, -1), x[nh : 2 * nh].reshape(self.n, -1)])
-        Bq, Bqd, Bqdd = self.basis
-        return Bq @ c.T + x[2 * nh :], Bqd @ c.T, Bqdd @ c.T
+        return _basis_states(x, self.n, self.harmonics, self.basis)
 
     def _update(self, x: NDArray[np.float64]) -> None:
         if self._x is not None and np.array_equal(x, self._x):

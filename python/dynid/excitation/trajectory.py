@@ -254,6 +254,17 @@ def _basis(t: NDArray[np.float64], wf: float, harmonics: int) -> tuple[NDArray[n
     return np.hstack([S / w, -C / w]), np.hstack([C, S]), np.hstack([-S * w, C * w])
 
 
+def _basis_states(
+    x: NDArray[np.float64], n: int, harmonics: int, basis: tuple[NDArray[np.float64], ...]
+) -> tuple[NDArray[np.float64], ...]:
+    """q, qd, qdd (T, n) of the optimiser's vector x = [a (n H), b (n H), q0 (n)] on the
+    :func:`_basis` of its time grid (the layout of :meth:`FourierTrajectory.to_vector`)."""
+    nh = n * harmonics
+    c = np.hstack([x[:nh].reshape(n, -1), x[nh : 2 * nh].reshape(n, -1)])
+    Bq, Bqd, Bqdd = basis
+    return Bq @ c.T + x[2 * nh :], Bqd @ c.T, Bqdd @ c.T
+
+
 # ---- limits -----------------------------------------------------------------------------------
 def _rest_projection(a: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:
     ell = np.arange(1.0, a.shape[1] + 1)

@@ -20,12 +20,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..identify import VARIANCE_FLOOR, LeastSquaresResult, relative_std
-from .base import Problem
+from .base import EstimatorFit, Problem
 
 #: Order of the autoregressive model of each joint's residual (the covariance's noise model).
 AR_ORDER = 10
@@ -266,3 +267,33 @@ def iterate(
         variance = fit.noise_variance
     assert fit is not None  # iterations >= 1
     return Iterated(fit, steps, done, at_jump, spent)
+
+
+def finished(
+    name: str, problem: Problem, run: Iterated, options_report: dict[str, Any], notes: list[str]
+) -> EstimatorFit:
+    """The estimator's answer after :func:`iterate`: the result, its report (the loop's
+    ``options_report``, the iterations, how they settled) and ``notes`` with what the iteration
+    says (not settled, settled at a jump of the map)."""
+    steps = run.steps
+    notes = list(notes)
+    if not run.settled:
+        notes.insert(
+            0,
+            f"{name}: not settled after {len(steps)} iterations (last step {steps[-1]:.3g} "
+            "std); raise iterations or check the controller's description",
+        )
+    if run.at_jump:
+        notes.append(
+            f"{name}: settled where the iteration's map jumps (a simulated velocity's sign "
+            f"flips between two samples): the jump is {steps[-1]:.2g} std"
+        )
+    report = {
+        **options_report,
+        "iterations": len(steps),
+        "settled": run.settled,
+        "settled_at_jump": run.at_jump,
+        "steps_std": steps,
+        "simulation_s": run.simulation_s,
+    }
+    return EstimatorFit(result(problem, run.fit, name), None, report, tuple(notes))

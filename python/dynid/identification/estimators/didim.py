@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .base import EstimatorFit, Problem
-from .closed_loop_fit import WeightedSolve, iterate, result, solve
+from .closed_loop_fit import WeightedSolve, finished, iterate, solve
 from .closed_loop_model import SETTLED_STD, closed_loop, plant, simulate_runs, simulated_columns
 
 NAME = "didim"
@@ -56,24 +56,4 @@ def didim(problem: Problem) -> EstimatorFit:
         return solve(replace(problem, Y=Y_s), Y_s, variance)
 
     run = iterate(problem, loop.iterations, regressor, one_solve, SETTLED_STD)
-    fit, steps, done = run.fit, run.steps, run.settled
-    notes = []
-    if not done:
-        notes.append(
-            f"{NAME}: not settled after {loop.iterations} iterations (last step "
-            f"{steps[-1]:.3g} std); raise iterations or check the controller's description"
-        )
-    if run.at_jump:
-        notes.append(
-            f"{NAME}: settled where the iteration's map jumps (a simulated velocity's sign "
-            f"flips between two samples): the jump is {steps[-1]:.2g} std"
-        )
-    report = {
-        **loop.report(problem.options),
-        "iterations": len(steps),
-        "settled": done,
-        "settled_at_jump": run.at_jump,
-        "steps_std": steps,
-        "simulation_s": run.simulation_s,
-    }
-    return EstimatorFit(result(problem, fit, "didim"), None, report, tuple(notes))
+    return finished(NAME, problem, run, loop.report(problem.options), [])
