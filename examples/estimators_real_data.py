@@ -76,9 +76,33 @@ RATIOS = {
 warnings.filterwarnings("ignore", message=r".*q: positions up to", category=UserWarning)
 
 
+#: The accelerations' noise that method "tls" needs (no fit can tell it from the torques): the
+#: standard deviation of each joint's prepared qdd above this fraction of its sampling rate,
+#: where the arms' exciting motions (below 1 Hz) have no content left.
+ACCELERATION_NOISE_BAND = 0.1
+
+
+def acceleration_noise(log: Any, robot: dynid.Robot, preparation: dict[str, Any]) -> Any:
+    """Per joint: the high-pass (above ACCELERATION_NOISE_BAND x fs) std of the prepared log's
+    accelerations, the estimate given to "tls" (floored at 1e-6 rad/s^2: "tls" wants > 0)."""
+    from dynid.logs.signal import lowpass
+
+    options = {k: v for k, v in preparation.items() if k != "min_velocity"}
+    prepared = dynid.prepare_log(log, **options) if options else log
+    qdd = prepared.qdd
+    if qdd is None:
+        qdd = dynid.prepare_log(prepared, differentiate="missing").qdd
+    high = qdd - lowpass(qdd, prepared.fs, ACCELERATION_NOISE_BAND * prepared.fs)
+    return np.maximum(high.std(axis=0), 1e-6)
+
+
 def timed_fit(log: Any, robot: dynid.Robot, **options: Any) -> tuple[Any, float, str]:
-    """(result or None, wall time in s, the refusal's message or "")."""
+    """(result or None, wall time in s, the refusal's message or ""); method "tls" gets the
+    log's :func:`acceleration_noise`."""
     start = time.perf_counter()
+    if options.get("method") == "tls":
+        noise = acceleration_noise(log, robot, options.get("preparation") or {})
+        options["estimator_options"] = {"acceleration_noise": noise.tolist()}
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
