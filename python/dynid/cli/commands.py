@@ -694,6 +694,7 @@ def excite(args: argparse.Namespace) -> None:
         ros_rate=args.ros_rate,
         overwrite=args.overwrite,
         inputs=inputs,
+        report=args.report,
     )
     print(
         f"{robot.name}: cond {result.condition_before:.4g} -> {result.condition_after:.4g} "
@@ -706,7 +707,8 @@ def excite(args: argparse.Namespace) -> None:
     )
     print(
         f"wrote {args.output}/trajectory.json, trajectory.csv ({args.rate:g} Hz), "
-        f"trajectory_ros.yaml ({args.ros_rate:g} Hz), trajectory.hpp",
+        f"trajectory_ros.yaml ({args.ros_rate:g} Hz), trajectory.hpp"
+        + (", report.html" if args.report else ""),
         flush=True,
     )
 

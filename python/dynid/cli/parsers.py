@@ -460,6 +460,7 @@ def _add_excite(subcommands: Any) -> None:
     p.add_argument("--friction", action="store_true", help="excite the friction columns too")
     p.add_argument("--seed", type=int, default=0, help="random start (default 0)")
     p.add_argument("--maxiter", type=int, default=200, help="SLSQP iterations (default 200)")
+    _add_report(p)
     _add_output(p, "dynid-excite")
     p.set_defaults(run=commands.excite)
 

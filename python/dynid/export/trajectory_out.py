@@ -41,9 +41,11 @@ def save_trajectory_folder(
     ros_rate: float = 100.0,
     overwrite: bool = False,
     inputs: Iterable[PathLike | None] = (),
+    report: bool = True,
 ) -> Path:
-    """Write the four files of ``plan`` into ``folder`` (see the module); ``model`` predicts the
-    CSV's torque (rnea: links, rotor inertia, friction). Returns the folder."""
+    """Write the four files of ``plan`` into ``folder`` (see the module), and with ``report``
+    report.html (:mod:`dynid.export.report_excite`: the trajectory against its limits);
+    ``model`` predicts the torque (rnea: links, rotor inertia, friction). Returns the folder."""
     if model.n != plan.trajectory.n:
         raise ValueError(f"model: expected {plan.trajectory.n} joints, got {model.n}")
     t = plan.times(rate)
@@ -54,6 +56,13 @@ def save_trajectory_folder(
         (staging / "trajectory.csv").write_text(trajectory_csv(plan, model, t), encoding="utf-8")
         (staging / "trajectory_ros.yaml").write_text(ros_yaml(plan, ros_t), encoding="utf-8")
         (staging / "trajectory.hpp").write_text(cpp_header(plan), encoding="utf-8")
+        if report:
+            from .report import write_page  # matplotlib: imported when the page is written
+            from .report_excite import excite_sections
+
+            write_page(
+                staging, f"dynid excite: {plan.model or model.name}", excite_sections(plan, model)
+            )
     return Path(folder)
 
 
