@@ -220,6 +220,7 @@ class Reader {
     const std::size_t int_start = pos_;
     const std::size_t int_digits = digits();
     if (int_digits == 0) {
+      if (at_end()) fail("unexpected end of the file inside a number");
       pos_ = start;
       fail("expected a value (a number, a string, a list, an object, true, false or null)");
     }
@@ -231,13 +232,15 @@ class Reader {
     if (peek() == '.') {
       ++pos_;
       value.integer = false;
-      if (digits() == 0) fail("expected digits after the decimal point");
+      if (digits() == 0) fail(at_end() ? "unexpected end of the file inside a number"
+                                       : "expected digits after the decimal point");
     }
     if (peek() == 'e' || peek() == 'E') {
       ++pos_;
       value.integer = false;
       if (peek() == '+' || peek() == '-') ++pos_;
-      if (digits() == 0) fail("expected digits in the exponent");
+      if (digits() == 0) fail(at_end() ? "unexpected end of the file inside a number"
+                                       : "expected digits in the exponent");
     }
     const char* first = text_.data() + start;
     const char* last = text_.data() + pos_;

@@ -112,7 +112,8 @@ std::string lower(std::string text) {
 }  // namespace
 
 Model parse_model(std::string_view json, const std::string& source) {
-  return prefixed(source + ": ", [&] { return detail::model_from_json(detail::parse_json(json, source)); });
+  const JsonValue data = detail::parse_json(json, source);  // its messages name the source
+  return prefixed(source + ": ", [&] { return detail::model_from_json(data); });
 }
 
 Model load_model(const std::string& path) {

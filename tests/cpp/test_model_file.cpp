@@ -142,7 +142,7 @@ const std::string kArm = R"({"convention": "standard", "rows": [[0.5, 0, 0, 0]])
 void self_checks() {
   // Syntax: each error names the value being read.
   refused(R"({"convention": "standard", "rows": [[0.5, 0, 0)", "rows[0][2]: not valid JSON");
-  refused(R"({"convention": "standard", "rows": [[0.5, 0, 0, 0]] x)", "extra data");
+  refused(R"({"convention": "standard", "rows": [[0.5, 0, 0, 0]]} x)", "extra data");
   refused(R"({"convention": "standard", "rows": [{"a": 01, "alpha": 0, "d": 0, "theta": 0}]})",
           "rows[0].a: not valid JSON: a number with a leading zero");
   refused(R"({"convention": "standard", "convention": "modified", "rows": []})",
