@@ -64,8 +64,7 @@ class Reader {
     }
     const std::string where = path_.empty() ? std::string() : path_ + ": ";
     throw std::invalid_argument(source_ + ": " + where + "not valid JSON: " + what + " (line " +
-                                std::to_string(line) + ", column " + std::to_string(column) +
-                                ")");
+                                std::to_string(line) + ", column " + std::to_string(column) + ")");
   }
 
   // A text file is UTF-8 (Python reads it as text first: "not a text file" otherwise).
@@ -73,9 +72,16 @@ class Reader {
     const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text_[i]); };
     for (pos_ = 0; pos_ < text_.size();) {
       const unsigned char c = byte(pos_);
-      std::size_t length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+      std::size_t length = c < 0x80           ? 1
+                           : (c >> 5) == 0x6  ? 2
+                           : (c >> 4) == 0xE  ? 3
+                           : (c >> 3) == 0x1E ? 4
+                                              : 0;
       bool valid = length != 0 && pos_ + length <= text_.size();
-      std::uint32_t code = length == 1 ? c : length == 2 ? (c & 0x1F) : length == 3 ? (c & 0x0F) : (c & 0x07);
+      std::uint32_t code = length == 1   ? c
+                           : length == 2 ? (c & 0x1F)
+                           : length == 3 ? (c & 0x0F)
+                                         : (c & 0x07);
       for (std::size_t k = 1; valid && k < length; ++k) {
         valid = (byte(pos_ + k) >> 6) == 0x2;
         code = (code << 6) | (byte(pos_ + k) & 0x3F);
@@ -232,15 +238,17 @@ class Reader {
     if (peek() == '.') {
       ++pos_;
       value.integer = false;
-      if (digits() == 0) fail(at_end() ? "unexpected end of the file inside a number"
-                                       : "expected digits after the decimal point");
+      if (digits() == 0)
+        fail(at_end() ? "unexpected end of the file inside a number"
+                      : "expected digits after the decimal point");
     }
     if (peek() == 'e' || peek() == 'E') {
       ++pos_;
       value.integer = false;
       if (peek() == '+' || peek() == '-') ++pos_;
-      if (digits() == 0) fail(at_end() ? "unexpected end of the file inside a number"
-                                       : "expected digits in the exponent");
+      if (digits() == 0)
+        fail(at_end() ? "unexpected end of the file inside a number"
+                      : "expected digits in the exponent");
     }
     const char* first = text_.data() + start;
     const char* last = text_.data() + pos_;
@@ -250,8 +258,8 @@ class Reader {
       // Python's float() gives.
       const bool negative = *first == '-';
       const double big = std::numeric_limits<double>::infinity();
-      value.number = magnitude_exponent(first, last) > 0 ? (negative ? -big : big)
-                                                         : (negative ? -0.0 : 0.0);
+      value.number =
+          magnitude_exponent(first, last) > 0 ? (negative ? -big : big) : (negative ? -0.0 : 0.0);
     } else if (r.ec != std::errc() || r.ptr != last) {
       pos_ = start;
       fail("a malformed number");
@@ -279,7 +287,8 @@ class Reader {
       const char* e = p + 1;
       const bool negative = *e == '-';
       if (*e == '-' || *e == '+') ++e;
-      for (; e != last; ++e) exponent = exponent < 100000000 ? exponent * 10 + (*e - '0') : exponent;
+      for (; e != last; ++e)
+        exponent = exponent < 100000000 ? exponent * 10 + (*e - '0') : exponent;
       if (negative) exponent = -exponent;
     }
     // The first significant digit is digit number `leading` (0-based) counted from the left.

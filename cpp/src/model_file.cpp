@@ -63,11 +63,10 @@ Model model_of_result(const JsonValue& data) {
                                 detail::json_kind_name(data.kind));
   const JsonValue* format = data.find("format");
   if (!format || format->kind != Kind::String || format->text != kResultFormat)
-    throw std::invalid_argument(std::string("format: expected '") + kResultFormat +
-                                "' (a dynid identify result), got " +
-                                (format ? detail::json_kind_name(format->kind) : "nothing") +
-                                (format && format->kind == Kind::String ? " '" + format->text + "'"
-                                                                        : std::string()));
+    throw std::invalid_argument(
+        std::string("format: expected '") + kResultFormat + "' (a dynid identify result), got " +
+        (format ? detail::json_kind_name(format->kind) : "nothing") +
+        (format && format->kind == Kind::String ? " '" + format->text + "'" : std::string()));
   // An integer 1..3 as Python reads it: 2.0 or true is not a version.
   const JsonValue* version = data.find("version");
   if (!version || version->kind != Kind::Number || !version->integer || version->number < 1 ||
@@ -135,8 +134,9 @@ Model load_model(const std::string& path) {
   const std::string suffix = lower(file.extension().string());
   if (suffix == ".yaml" || suffix == ".yml")
     throw std::invalid_argument(
-        name + ": YAML model files are read by Python only; convert it to JSON once: "
-               "python -c \"import dynid; dynid.save_model(dynid.load_model('" +
+        name +
+        ": YAML model files are read by Python only; convert it to JSON once: "
+        "python -c \"import dynid; dynid.save_model(dynid.load_model('" +
         name + "'), 'model.json')\"");
   if (suffix != ".json")
     throw std::invalid_argument(name + ": unknown extension '" + file.extension().string() +

@@ -42,8 +42,7 @@ std::string describe(const JsonValue& v) {
 
 std::string shape_text(const std::vector<int>& shape) {
   std::string text = "(";
-  for (std::size_t k = 0; k < shape.size(); ++k)
-    text += (k ? ", " : "") + std::to_string(shape[k]);
+  for (std::size_t k = 0; k < shape.size(); ++k) text += (k ? ", " : "") + std::to_string(shape[k]);
   return text + (shape.size() == 1 ? ",)" : ")");  // Python's tuple notation
 }
 
@@ -112,7 +111,8 @@ DHRow row(const JsonValue& v, int i, bool modified) {
         {"d"},
         {"theta", "theta_offset"}};
     std::vector<std::string> accepted;
-    for (const auto& aliases : names) accepted.insert(accepted.end(), aliases.begin(), aliases.end());
+    for (const auto& aliases : names)
+      accepted.insert(accepted.end(), aliases.begin(), aliases.end());
     std::sort(accepted.begin(), accepted.end());
     for (const std::string& key : v.keys) {
       if (std::find(accepted.begin(), accepted.end(), key) != accepted.end()) continue;
@@ -176,11 +176,13 @@ Model model_from_json(const JsonValue& data) {
     const JsonValue* dh = data.find("dh");
     if (!data.find("rows") && dh && dh->kind == Kind::Object)
       hint = " (the DH rows must be a top-level 'rows' list, with 'convention')";
-    for (const char* field : kModelFileFields) expected += (expected.empty() ? "" : ", ") + std::string(field);
+    for (const char* field : kModelFileFields)
+      expected += (expected.empty() ? "" : ", ") + std::string(field);
     refuse("unknown field(s) " + unknown + hint + "; expected " + expected);
   }
   for (const char* key : {"convention", "rows"})
-    if (!data.find(key)) refuse(std::string(key) + ": missing (a model needs 'convention' and 'rows')");
+    if (!data.find(key))
+      refuse(std::string(key) + ": missing (a model needs 'convention' and 'rows')");
   const JsonValue& convention = *data.find("convention");
   if (convention.kind != Kind::String ||
       (convention.text != "standard" && convention.text != "modified"))
@@ -265,7 +267,8 @@ Model model_from_json(const JsonValue& data) {
   // (homogeneous transforms, ordered limits, an invertible transmission, ...).
   Model model(std::move(dh), modified ? Convention::Modified : Convention::Standard);
   if (!name.empty()) model.set_name(name);
-  if (const Array* a = value("gravity")) model.set_gravity(Vector3(a->values[0], a->values[1], a->values[2]));
+  if (const Array* a = value("gravity"))
+    model.set_gravity(Vector3(a->values[0], a->values[1], a->values[2]));
   if (const Array* a = value("base")) model.set_base(matrix(a->values, 4, 4));
   if (const Array* a = value("tool")) model.set_tool(matrix(a->values, 4, 4));
   if (has_names) model.set_joint_names(joint_names);

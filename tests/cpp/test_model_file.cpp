@@ -21,9 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "dynid/dynid.hpp"
-#include "dynid/detail/model_file_fields.hpp"
 #include "allocation_counter.hpp"  // cpp/examples/ (after Eigen: it replaces posix_memalign)
+#include "dynid/detail/model_file_fields.hpp"
+#include "dynid/dynid.hpp"
 
 namespace {
 
@@ -178,8 +178,9 @@ void self_checks() {
           "rows[0]: missing 'theta' or 'theta_offset'");
   refused(R"({"convention": "standard", "rows": [{"a": 0.5, "alpha": true, "d": 0, "theta": 0}]})",
           "rows[0].alpha: expected a finite number, got true");
-  refused(R"({"convention": "standard", "rows": [{"a_prev": 0.5, "alpha": 0, "d": 0, "theta": 0}]})",
-          "rows[0]: unknown field 'a_prev' ('a_prev' is modified-DH notation");
+  refused(
+      R"({"convention": "standard", "rows": [{"a_prev": 0.5, "alpha": 0, "d": 0, "theta": 0}]})",
+      "rows[0]: unknown field 'a_prev' ('a_prev' is modified-DH notation");
   refused(R"({"convention": "modified", "rows": [{"a": 0, "a_prev": 0, "alpha": 0, "d": 0,
               "theta": 0}]})",
           "rows[0]: both 'a' and 'a_prev' given for a");
@@ -192,8 +193,10 @@ void self_checks() {
   refused(kArm + R"(, "joint_names": ["a", "b"]})", "joint_names: expected 1 names, got 2");
   refused(kArm + R"(, "params": [[1, 0, 0, 0, 0, 0, 0, 0, 0]]})",
           "params: expected numbers of shape (1, 10), got shape (1, 9)");
-  refused(kArm + R"(, "params": "zeros"})", "params: expected numbers of shape (1, 10), got 'zeros'");
-  refused(kArm + R"(, "params": [[1, 0, 0, 0, 0, 0, 0, 0, 0, false]]})", "params: expected numbers");
+  refused(kArm + R"(, "params": "zeros"})",
+          "params: expected numbers of shape (1, 10), got 'zeros'");
+  refused(kArm + R"(, "params": [[1, 0, 0, 0, 0, 0, 0, 0, 0, false]]})",
+          "params: expected numbers");
   refused(kArm + R"(, "params": [[1, 0, 0, 0, 0, 0, 0, 0, 0, [0]]]})", "params: expected numbers");
   refused(kArm + R"(, "Ia": [-Infinity]})", "Ia: contains NaN or inf");
   refused(kArm + R"(, "gravity": [0, 0]})", "gravity: expected numbers of shape (3,)");
