@@ -53,7 +53,6 @@ def _every_field_arm() -> dynid.Robot:
     for i in range(4):
         inertia = np.diag(rng.uniform(0.01, 0.02, 3))
         robot.set_link(i, 1.0 + i, rng.uniform(-0.05, 0.05, 3), inertia)
-    rotation = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])
     base = np.eye(4)
     base[:3, :3] = [[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]  # a quarter turn about z
     base[:3, 3] = [0.1, 0.2, 0.3]
