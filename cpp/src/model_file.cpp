@@ -121,10 +121,19 @@ Model load_model(const std::string& path) {
   const bool folder = fs::is_directory(file, error);
   if (folder) file /= kResultFile;
   const bool result = folder || file.filename() == kResultFile;
-  if (!fs::is_regular_file(file, error))
-    throw std::invalid_argument(
-        "path: " + std::string(result ? "no result file " : "no such file: ") + file.string() +
-        (result ? " (a folder written by dynid identify holds one)" : ""));
+  if (!fs::is_regular_file(file, error)) {
+    if (result)
+      throw std::invalid_argument("path: no result file " + file.string() +
+                                  " (a folder written by dynid identify holds one)");
+    // A bare name is a built-in model to Python's load_model; the C++ library has none.
+    const std::string hint =
+        file.has_extension() || file.has_parent_path()
+            ? ""
+            : " (the built-in models are Python's: write this one as a model file with "
+              "dynid.save_model(dynid.load_model('" +
+                  path + "'), '" + path + ".json'))";
+    throw std::invalid_argument("path: no such file: " + file.string() + hint);
+  }
   const std::string name = file.string();
   if (result) {
     const std::string text = read_file(file, kMaxResultBytes);

@@ -253,6 +253,16 @@ void self_checks() {
   } catch (const std::invalid_argument& e) {
     if (std::string(e.what()).rfind("path: no such file", 0) != 0) fail(e.what());
   }
+  // A built-in model's name (Python's load_model reads those) says how to write its file.
+  ++probes;
+  try {
+    dynid::load_model("kuka_lwr4");
+    fail("no error for a built-in model's name");
+  } catch (const std::invalid_argument& e) {
+    if (std::string(e.what()).find("dynid.save_model(dynid.load_model('kuka_lwr4'), "
+                                   "'kuka_lwr4.json')") == std::string::npos)
+      fail(e.what());
+  }
 }
 
 }  // namespace
