@@ -21,9 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "allocation_counter.hpp"  // cpp/examples/ (after Eigen: it replaces posix_memalign)
 #include "dynid/detail/model_file_fields.hpp"
 #include "dynid/dynid.hpp"
+
+#include "allocation_counter.hpp"  // cpp/examples/ (after Eigen: it replaces posix_memalign)
 
 namespace {
 
