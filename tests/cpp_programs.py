@@ -35,6 +35,7 @@ PROGRAMS = (
     "transmission_no_allocation",
     "uses_no_allocation",
     "batch",
+    "model_file",
     "realtime_loop",
 )
 

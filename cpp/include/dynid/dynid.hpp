@@ -17,6 +17,7 @@
 #include "dynid/kinematics.hpp"
 #include "dynid/kuka_like_controller.hpp"
 #include "dynid/model.hpp"
+#include "dynid/model_file.hpp"
 #include "dynid/momentum_observer.hpp"
 #include "dynid/recursive_least_squares.hpp"
 #include "dynid/regressor.hpp"
