@@ -61,6 +61,9 @@ def _every_field_arm() -> dynid.Robot:
     tool[2, 3] = 0.12
     robot.tool = tool
     robot.joint_names = ["shoulder", "elbow", "slide", "wrist"]
+    robot.link_names = ["upper_arm", "forearm", "carriage", "hand"]
+    robot.velocity_limits = [2.0, np.inf, 0.5, 3.0]  # inf: a null in the file
+    robot.effort_limits = [150.0, 80.0, 400.0, np.inf]
     robot.qlim = np.array([[-2.0, 2.0], [-1.5, 1.0], [-0.1, 0.4], [-3.0, 3.0]])
     robot.Ia, robot.Fv, robot.Fs = rng.uniform(0.1, 0.5, (3, 4))
     transmission = np.eye(4)

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -207,8 +208,8 @@ Model model_from_json(const JsonValue& data) {
   // Every value checked for its type and shape before the model is built (Python's `values`),
   // in the order of the fields.
   std::string name;
-  std::vector<std::string> joint_names;
-  bool has_names = false;
+  std::vector<std::string> joint_names, link_names;
+  bool has_joint_names = false, has_link_names = false;
   struct Array {
     std::vector<int> shape;
     std::vector<double> values;
@@ -230,16 +231,28 @@ Model model_from_json(const JsonValue& data) {
     if (key == "name") {
       if (v->kind != Kind::String) refuse("name: expected a string, got " + describe(*v));
       name = v->text;  // "" means the default
-    } else if (key == "joint_names") {
+    } else if (key == "joint_names" || key == "link_names") {
       // the count, empty and repeated names are checked by the setter
       const bool strings = v->kind == Kind::Array &&
                            std::all_of(v->items.begin(), v->items.end(),
                                        [](const JsonValue& x) { return x.kind == Kind::String; });
       if (!strings)
-        refuse("joint_names: expected a list of " + std::to_string(n) + " strings, got " +
+        refuse(key + ": expected a list of " + std::to_string(n) + " strings, got " + describe(*v));
+      std::vector<std::string>& names = key == "joint_names" ? joint_names : link_names;
+      for (const JsonValue& x : v->items) names.push_back(x.text);
+      (key == "joint_names" ? has_joint_names : has_link_names) = true;
+    } else if (key == "velocity_limits" || key == "effort_limits") {
+      // n numbers or nulls, null meaning no limit (+inf: JSON has no infinity); the setter
+      // refuses values <= 0
+      if (v->kind != Kind::Array || v->items.size() != static_cast<std::size_t>(n))
+        refuse(key + ": expected a list of " + std::to_string(n) + " numbers or nulls, got " +
                describe(*v));
-      for (const JsonValue& x : v->items) joint_names.push_back(x.text);
-      has_names = true;
+      std::vector<double> limits;
+      for (std::size_t i = 0; i < v->items.size(); ++i)
+        limits.push_back(v->items[i].kind == Kind::Null
+                             ? std::numeric_limits<double>::infinity()
+                             : number(v->items[i], key + "[" + std::to_string(i) + "]"));
+      arrays.emplace_back(key, Array{{n}, limits});
     } else {
       const std::vector<int> shape = shape_of(key);
       arrays.emplace_back(key, Array{shape, numbers(*v, key, shape)});
@@ -271,8 +284,11 @@ Model model_from_json(const JsonValue& data) {
     model.set_gravity(Vector3(a->values[0], a->values[1], a->values[2]));
   if (const Array* a = value("base")) model.set_base(matrix(a->values, 4, 4));
   if (const Array* a = value("tool")) model.set_tool(matrix(a->values, 4, 4));
-  if (has_names) model.set_joint_names(joint_names);
+  if (has_joint_names) model.set_joint_names(joint_names);
+  if (has_link_names) model.set_link_names(link_names);
   if (const Array* a = value("qlim")) model.set_joint_limits(matrix(a->values, n, 2));
+  if (const Array* a = value("velocity_limits")) model.set_velocity_limits(vector(a->values));
+  if (const Array* a = value("effort_limits")) model.set_effort_limits(vector(a->values));
   if (const Array* a = value("params")) model.set_parameters(matrix(a->values, n, 10));
   if (const Array* a = value("Ia")) model.set_rotor_inertia(vector(a->values));
   if (const Array* a = value("Fv")) model.set_viscous_friction(vector(a->values));

@@ -58,7 +58,12 @@ void print_fields(const dynid::Model& model) {
   std::printf("field joint_names");
   for (const std::string& name : model.joint_names()) std::printf(" %s", name.c_str());
   std::printf("\n");
+  std::printf("field link_names");
+  for (const std::string& name : model.link_names()) std::printf(" %s", name.c_str());
+  std::printf("\n");
   print_matrix("field qlim", model.joint_limits());
+  print_numbers("field velocity_limits", model.velocity_limits().data(), model.n());
+  print_numbers("field effort_limits", model.effort_limits().data(), model.n());
   print_matrix("field params", model.parameters());
   print_numbers("field Ia", model.rotor_inertia().data(), model.n());
   print_numbers("field Fv", model.viscous_friction().data(), model.n());
@@ -192,6 +197,10 @@ void self_checks() {
   refused(kArm + R"(, "name": 3})", "name: expected a string, got 3");
   refused(kArm + R"(, "joint_names": [1]})", "joint_names: expected a list of 1 strings");
   refused(kArm + R"(, "joint_names": ["a", "b"]})", "joint_names: expected 1 names, got 2");
+  refused(kArm + R"(, "link_names": ["a", ""]})", "link_names:");
+  refused(kArm + R"(, "velocity_limits": [0]})", "velocity_limits:");
+  refused(kArm + R"(, "effort_limits": [1, 2]})", "effort_limits: expected a list of 1 numbers");
+  refused(kArm + R"(, "effort_limits": ["x"]})", "effort_limits[0]: expected a finite number");
   refused(kArm + R"(, "params": [[1, 0, 0, 0, 0, 0, 0, 0, 0]]})",
           "params: expected numbers of shape (1, 10), got shape (1, 9)");
   refused(kArm + R"(, "params": "zeros"})",

@@ -12,10 +12,25 @@
 namespace dynid::detail {
 
 // The model's fields, in the order Python writes them (robot_fields.FIELDS' file keys).
-constexpr std::array<const char*, 16> kModelFileFields = {
-    "name", "convention",   "joint_types", "gravity",      "rows", "base",
-    "tool", "joint_names",  "qlim",        "params",       "Ia",   "Fv",
-    "Fs",   "transmission", "gear_ratios", "joint_offsets"};
+constexpr std::array<const char*, 19> kModelFileFields = {"name",
+                                                          "convention",
+                                                          "joint_types",
+                                                          "gravity",
+                                                          "rows",
+                                                          "base",
+                                                          "tool",
+                                                          "joint_names",
+                                                          "link_names",
+                                                          "qlim",
+                                                          "velocity_limits",
+                                                          "effort_limits",
+                                                          "params",
+                                                          "Ia",
+                                                          "Fv",
+                                                          "Fs",
+                                                          "transmission",
+                                                          "gear_ratios",
+                                                          "joint_offsets"};
 
 // Fields a model file may hold besides the model (ignored).
 constexpr std::array<const char*, 6> kModelFileMetadata = {"format", "version", "description",
