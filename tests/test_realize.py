@@ -83,3 +83,21 @@ def test_undetermined_parameters_are_refused(exact):
     std[0] = np.inf
     with pytest.raises(ValueError, match="not determined by the data"):
         consistent_robot(dataclasses.replace(result, std=std))
+
+
+def test_export_writes_a_model_file_for_cpp(exact, tmp_path):
+    """--model-file: the consistent robot as a model file (what dynid::load_model reads in C++),
+    written atomically; it predicts the least-squares model's torques."""
+    robot, result = exact
+    save_result(result, tmp_path / "ls")
+    model = tmp_path / "identified.json"
+    argv = ["export", str(tmp_path / "ls"), "--model-file", str(model), "--name", "ident"]
+    assert dynid.cli.main(argv) == 0
+    again = dynid.load_model(model)
+    assert again.name == "ident"
+    q, qd, qdd = _states(robot.n, 5)
+    expected = result.regressor(q, qd, qdd) @ result.theta
+    assert np.max(np.abs(again.rnea(q, qd, qdd) - expected)) <= 1e-6 * np.max(np.abs(expected))
+    assert dynid.cli.main(argv) == 2  # exists: not replaced without --overwrite
+    bad = ["export", str(tmp_path / "ls"), "--model-file", str(tmp_path / "m.txt")]
+    assert dynid.cli.main(bad) == 2

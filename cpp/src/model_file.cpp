@@ -87,8 +87,9 @@ Model model_of_result(const JsonValue& data) {
   if (!physical || physical->kind == Kind::Null)
     throw std::invalid_argument(
         "a least-squares result (no 'physical' entry) holds base parameters only, not a full "
-        "robot; identify with --physical (dynid identify LOG --physical) for a model that "
-        "dynid::load_model reads");
+        "robot; write its physically consistent robot as a model file (dynid export RESULT "
+        "--model-file model.json) or identify with --physical (dynid identify LOG --physical) "
+        "for a model that dynid::load_model reads");
   if (physical->kind != Kind::Object)
     throw std::invalid_argument(std::string("physical: expected an object, got ") +
                                 detail::json_kind_name(physical->kind));

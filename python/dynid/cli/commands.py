@@ -520,6 +520,7 @@ def export(args: argparse.Namespace) -> None:
         tip_link=getattr(args, "tip_link", None),
         name=args.name,
         overwrite=args.overwrite,
+        model_file=args.model_file,
     )
     print(f"wrote {', '.join(map(str, written))}", flush=True)
 

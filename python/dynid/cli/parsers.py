@@ -172,11 +172,13 @@ def _add_info(subcommands: Any) -> None:
 def _add_export(subcommands: Any) -> None:
     p = subcommands.add_parser(
         "export",
-        help="write a model or a physically consistent result as URDF and/or MuJoCo MJCF",
-        description="Write the robot of SOURCE as a URDF and/or a MuJoCo MJCF file: SOURCE is a "
-        "result folder (or its result.json) of `dynid identify --physical`, a built-in model "
-        "name, a model file or a URDF. Least-squares results hold base parameters only and "
-        "cannot be exported.",
+        help="write a model or an identified robot as URDF, MuJoCo MJCF or a model file",
+        description="Write the robot of SOURCE as a URDF, a MuJoCo MJCF and/or a model file "
+        "(JSON: what dynid::load_model reads in C++): SOURCE is a result folder (or its "
+        "result.json) of `dynid identify`, a built-in model name, a model file or a URDF. A "
+        "least-squares result is written as the physically consistent robot closest to it "
+        "(refused when none is within a standard deviation of every base parameter; "
+        "docs/export.md).",
     )
     p.add_argument("source", metavar="SOURCE", help="result folder/result.json, model or URDF")
     p.add_argument("--urdf", metavar="FILE", help="the URDF file to write")
@@ -192,6 +194,11 @@ def _add_export(subcommands: Any) -> None:
         metavar="FILE",
         help="the MuJoCo MJCF file to write (armature = Ia, damping = Fv, frictionloss = Fs; "
         "docs/export.md)",
+    )
+    p.add_argument(
+        "--model-file",
+        metavar="FILE",
+        help="the model file to write (.json, which C++'s dynid::load_model reads, or .yaml)",
     )
     p.add_argument("--name", help="robot name in the URDF (default: the model's name)")
     p.add_argument("--overwrite", action="store_true", help="replace the files if they exist")

@@ -34,7 +34,7 @@ from ..identification.blocks.registry import blocks_from_record, friction_models
 from ..identification.blocks.rigid_body import RigidBody
 from ..identification.log_identification import LogIdentification, LogValidation
 from ..logs.log_files import Log
-from ..model.model_files import dumps_json, load_model, model_from_dict
+from ..model.model_files import dumps_json, load_model, model_from_dict, model_text
 from ..model.robot import Robot
 from .output_folder import output_folder
 
@@ -513,6 +513,7 @@ def export_robot(
     tip_link: str | None = None,
     name: str | None = None,
     overwrite: bool = False,
+    model_file: PathLike | None = None,
 ) -> list[Path]:
     """Write the robot of ``source`` as URDF (``urdf``) and/or MuJoCo MJCF (``mjcf``; at least
     one) for ``dynid export``: ``source`` is a result folder or ``result.json`` of a physically
@@ -533,8 +534,15 @@ def export_robot(
 
     if into is not None and urdf is None:
         raise ValueError("into: the user's URDF to update needs --urdf OUT, the file to write")
-    if urdf is None and mjcf is None:
-        raise ValueError("urdf, mjcf: give at least one file to write (--urdf FILE, --mjcf FILE)")
+    if urdf is None and mjcf is None and model_file is None:
+        raise ValueError(
+            "urdf, mjcf, model_file: give at least one file to write (--urdf FILE, --mjcf FILE, "
+            "--model-file FILE)"
+        )
+    if model_file is not None and Path(model_file).suffix.lower() not in (".json", ".yaml", ".yml"):
+        raise ValueError(
+            f"model_file: expected a .json, .yaml or .yml file (C++: .json), got {model_file}"
+        )
     # The links choose the chain of a URDF source too (a DH model or a result has none).
     urdf_source = str(source).lower().endswith(".urdf")
     links = {"tip_link": tip_link, "base_link": base_link} if urdf_source else {}
@@ -547,7 +555,7 @@ def export_robot(
     else:
         robot = loaded
     name = name or robot.name
-    targets = [Path(p) for p in (urdf, mjcf) if p is not None]
+    targets = [Path(p) for p in (urdf, mjcf, model_file) if p is not None]
     for target in targets:
         if target.exists() and not overwrite:
             raise ValueError(
@@ -569,4 +577,9 @@ def export_robot(
         written.append(Path(urdf))
     if mjcf is not None:
         written.append(write_mjcf(robot, mjcf, name=name, overwrite=overwrite))
+    if model_file is not None:  # what dynid::load_model reads in C++ (a .json one)
+        named = robot.copy()
+        named.name = name
+        text = model_text(named, model_file)
+        written.append(write_urdf(text, model_file, overwrite=overwrite))  # atomic, any text
     return written

@@ -123,15 +123,22 @@ def save_model(robot: Robot, path: PathLike) -> Path:
     drive terms (floats are written with 17 significant digits, i.e. exactly).
     """
     path = Path(path)
+    path.write_text(model_text(robot, path))
+    return path
+
+
+def model_text(robot: Robot, path: PathLike) -> str:
+    """The content of ``robot``'s model file at ``path``: JSON, or YAML for .yaml/.yml
+    (ValueError naming ``path`` for another extension)."""
+    path = Path(path)
     data = model_to_dict(robot)
     if path.suffix.lower() in YAML_SUFFIXES:
         yaml = _yaml(path)
-        path.write_text(yaml.safe_dump(data, sort_keys=False))
-    elif path.suffix.lower() == ".json":
-        path.write_text(dumps_json(data) + "\n")
-    else:
-        raise ValueError(f"path: unknown extension {path.suffix!r}; expected .json, .yaml or .yml")
-    return path
+        text: str = yaml.safe_dump(data, sort_keys=False)
+        return text
+    if path.suffix.lower() == ".json":
+        return dumps_json(data) + "\n"
+    raise ValueError(f"path: unknown extension {path.suffix!r}; expected .json, .yaml or .yml")
 
 
 # --------------------------------------------------------------------------- dict <-> Robot
