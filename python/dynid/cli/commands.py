@@ -655,7 +655,7 @@ def excite(args: argparse.Namespace) -> None:
     qd_max = _limit_option(args.qd_max, urdf_velocity, 1.0, robot.n, "--qd-max")
     qdd_max = _limit_option(args.qdd_max, None, 2.0, robot.n, "--qdd-max")
     tau_max = _limit_option(args.tau_max, urdf_effort, None, robot.n, "--tau-max")
-    keep_out = _keep_out(args)
+    keep_out = _keep_out(args, robot)
     start = time.perf_counter()
     last = [start]
 
@@ -714,11 +714,23 @@ def excite(args: argparse.Namespace) -> None:
     )
 
 
-def _keep_out(args: argparse.Namespace) -> Any:
-    """--floor, --box, --capsule-radius, --keep-out-margin as a KeepOut (None without any)."""
+def _keep_out(args: argparse.Namespace, robot: Any) -> Any:
+    """--floor, --box, --capsule-radius, --keep-out-margin as a KeepOut (None without any);
+    --capsule-radius urdf: each segment's radius from the URDF model's collision geometry."""
     if args.floor is None and args.box is None and args.capsule_radius is None:
         return None
     from ..excitation.cartesian import KeepOut
+
+    if args.capsule_radius == "urdf":
+        if not str(args.model).lower().endswith(".urdf"):
+            raise ValueError("--capsule-radius urdf: needs a URDF --model (its <collision>)")
+        from ..model.urdf.collision import segment_radii
+
+        links = {k: getattr(args, k, None) for k in ("base_link", "tip_link")}
+        try:
+            args.capsule_radius = segment_radii(args.model, robot.convention, **links).tolist()
+        except ValueError as exc:
+            raise ValueError(f"--capsule-radius urdf: {exc}") from None
 
     options = {"floor": "--floor", "box": "--box", "radii": "--capsule-radius"}
     try:

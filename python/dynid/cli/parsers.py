@@ -290,6 +290,11 @@ def _per_joint(text: str) -> list[float]:
         ) from None
 
 
+def _radii_or_urdf(text: str) -> list[float] | str:
+    """--capsule-radius: numbers (one, or one per segment) or 'urdf'."""
+    return text if text == "urdf" else _per_joint(text)
+
+
 def _add_simulate(subcommands: Any) -> None:
     p = subcommands.add_parser(
         "simulate",
@@ -449,11 +454,11 @@ def _add_excite(subcommands: Any) -> None:
     )
     p.add_argument(
         "--capsule-radius",
-        type=_per_joint,
-        metavar="R",
+        type=_radii_or_urdf,
+        metavar="R|urdf",
         help="keep non-adjacent links apart, each a capsule of this radius [m] about the segment "
         "between consecutive DH frame origins (n + 1 segments, the last to the tool point; one "
-        "radius or n + 1)",
+        "radius or n + 1), or 'urdf': each from its link's URDF <collision> geometry",
     )
     p.add_argument(
         "--keep-out-margin",

@@ -154,6 +154,12 @@ class KeepOutConstraint:
         self.radii, self.pairs = capsule_pairs(robot, keep_out, q_ref)
         self._x: NDArray[np.float64] | None = None
 
+    @property
+    def empty(self) -> bool:
+        """No inequality at all: capsules only, and no pair of them that the motion can bring
+        closer (a short arm whose links are all adjacent or meet by construction)."""
+        return self.keep_out.floor is None and self.keep_out.box is None and not self.pairs.size
+
     def _update(self, x: NDArray[np.float64]) -> None:
         if self._x is not None and np.array_equal(x, self._x):
             return
@@ -269,7 +275,7 @@ def _rows(P: NDArray, dP: NDArray, keep_out: KeepOut, radii: NDArray, pairs: NDA
         d_on_i = (1 - s)[..., None, None] * dPt[:, i] + s[..., None, None] * dPt[:, i + 1]
         d_on_j = (1 - u)[..., None, None] * dPt[:, j] + u[..., None, None] * dPt[:, j + 1]
         parts.append(np.einsum("tpk,tpkn->tpn", unit, d_on_i - d_on_j))
-    return np.concatenate(parts, axis=1)
+    return np.concatenate(parts, axis=1) if parts else np.zeros((P.shape[0], 0, dP.shape[0]))
 
 
 def _segment_distance(P: NDArray, pairs: NDArray) -> tuple[NDArray, ...]:

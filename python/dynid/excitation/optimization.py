@@ -179,7 +179,9 @@ def optimize_excitation(
     if space is not None:
         # the Cartesian motion needs a finer grid than the joints' 20 H: samples points
         keep_t = period * np.arange(samples) / samples
-        constraints.append(KeepOutConstraint(robot, space, keep_t, wf, harmonics, q_ref).as_dict())
+        keeping = KeepOutConstraint(robot, space, keep_t, wf, harmonics, q_ref)
+        if not keeping.empty:  # SLSQP refuses a constraint of no rows
+            constraints.append(keeping.as_dict())
     if at_rest:
         constraints.append(_rest_equalities(n, harmonics))
     x0 = start.to_vector()

@@ -41,7 +41,7 @@ def save_trajectory_folder(
     ros_rate: float = 100.0,
     overwrite: bool = False,
     inputs: Iterable[PathLike | None] = (),
-    report: bool = True,
+    report: bool = False,
 ) -> Path:
     """Write the four files of ``plan`` into ``folder`` (see the module), and with ``report``
     report.html (:mod:`dynid.export.report_excite`: the trajectory against its limits);

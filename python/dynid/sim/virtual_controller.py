@@ -442,9 +442,7 @@ FIG5_SAMPLE_TIME = 0.12
 FIG5_DURATION = 60.0
 
 
-def paper_final_validation_trajectory(
-    t: NDArray[np.float64],
-) -> tuple[NDArray, NDArray, NDArray]:
+def paper_final_validation_trajectory(t: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
     """The 7 joints' sinusoids of the paper's final validation experiment (Fig. 5): joint j
     follows A_j sin(2 pi t / T_j) with ``FIG5_AMPLITUDES`` and ``FIG5_PERIODS``; (q, qd, qdd),
     (T, 7) each."""
