@@ -679,21 +679,26 @@ def _correlation_robust_std(
     if correlation_time < WHITE_CORRELATION_TIME:  # independent samples: the white covariance
         return []
     width = WIDTH_PER_WINDOW * window
-    A = np.zeros((p, p))
-    parts = []
-    for r, c, cached in chunks:
+
+    def weighted(r: int, c: slice, cached: NDArray[np.float64] | None) -> tuple[NDArray, NDArray]:
+        # A chunk's rows (the left-out ones zero) and their weighted copy; computed again in the
+        # second pass when not cached, so that memory stays one chunk, as in the fit.
         Y = cached if cached is not None else regressor(r, c)
         rows = row_masks[r]
         if rows is not None:
             Y = np.where(rows[c][:, :, None], Y, 0.0)
-        WY = Y * weights[None, :, None]
+        return Y, Y * weights[None, :, None]
+
+    A = np.zeros((p, p))
+    for r, c, cached in chunks:
+        Y, WY = weighted(r, c, cached)
         A += np.einsum("tjp,tjq->pq", WY, Y)
-        parts.append((r, Y, WY))
     scale = 1.0 / np.sqrt(np.where(np.diag(A) > 0, np.diag(A), 1.0))
     inverse = scale[:, None] * np.linalg.pinv(A * scale[:, None] * scale[None, :]) * scale[None, :]
     accumulator = LongRunAccumulator(p, width)
     current = 0
-    for (r, c, _), (_, Y, WY) in zip(chunks, parts):
+    for r, c, cached in chunks:
+        Y, WY = weighted(r, c, cached)
         if r != current:
             accumulator.end_segment()
             current = r
