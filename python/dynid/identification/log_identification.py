@@ -413,7 +413,9 @@ def identify_log(
     docs/identification.md, "Estimators"), which starts from the WLS fit and takes its own
     ``estimator_options`` (its report is ``result.estimator``). ``exclude_joints`` (0-based)
     leaves those joints' rows out of the fit. Raises ValueError (RankDeficientError) when the log
-    does not excite every base parameter.
+    does not excite every base parameter. OLS and WLS standard deviations account for the
+    residuals' correlation in time when there is any (a filtered log, a model error; Newey-West,
+    :mod:`dynid.identification.serial_correlation`; a training note says so).
 
     ``physical=True`` estimates physically consistent standard parameters instead
     (:func:`dynid.physical_least_squares`, same columns; WLS weights 1/sigma_j from the
