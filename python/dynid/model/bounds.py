@@ -19,8 +19,7 @@ any joint types there, and this module estimates its four constants:
 - k6 = max over q of ||g(q)||.
 
 M(q) = B(q) + diag(Ia) is ``robot.mass_matrix`` (rotor inertias included). k2, k3, k5, k7, the
-growth with ||q|| of prismatic joints over unbounded ranges, are not estimated: they are not unique
-(any split between the constant and the growth terms bounds the same data).
+growth with the prismatic displacements for every q, are :mod:`dynid.model.growth_bounds`'.
 
 These are ESTIMATES, not guaranteed bounds: extreme values of non-convex functions, found by
 evaluating the terms at ``samples`` random configurations (uniform in ``qlim``; unit velocity
