@@ -527,11 +527,8 @@ def _add_closed_loop_estimators(p: argparse.ArgumentParser) -> None:
 
 
 def _gains(text: str) -> float | list[float]:
-    """--kp, --kd: one number or a comma-separated list, one per joint."""
-    try:
-        values = [float(v) for v in text.split(",")]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected K or K1,K2,...; got {text!r}") from None
+    """--kp, --kd of iv/didim: one number (a scalar gain) or one per joint (:func:`_per_joint`)."""
+    values = _per_joint(text)
     return values[0] if len(values) == 1 else values
 
 
