@@ -89,12 +89,7 @@ def long_run_covariance(
             continue
         cumulative = np.vstack([np.zeros(q), np.cumsum(h, axis=0)])
         batches = cumulative[L:] - cumulative[:-L]  # (T - L + 1, q) sums of L consecutive h_t
-        # T / (T - L + 1): the batches cover T - L + 1 starts of the T samples; T / (T - L):
-        # the fitted residuals sum to zero on the regressor (the normal equations), which takes
-        # about L / T of the batches' variance away (Meketon & Schmeiser's overlapping batch
-        # means, Proc. Winter Simulation Conference 1984, have the same factor).
-        scale = T / (T - L + 1) * (T / (T - L) if T > L else 1.0)
-        omega += batches.T @ batches / L * scale
+        omega += batches.T @ batches / L * _batch_scale(T, L)
     return omega
 
 
@@ -131,10 +126,18 @@ class LongRunAccumulator:
     def end_segment(self) -> None:
         """Close the current segment (with the factors of :func:`long_run_covariance`)."""
         T, L = self._count, min(self.width, max(self._count, 1))
-        if T:  # the factors of long_run_covariance (none for white rows, L = 1)
-            scale = 1.0 if L == 1 else T / (T - L + 1) * (T / (T - L) if T > L else 1.0)
-            self.omega += self._batches / L * scale
+        if T:  # as long_run_covariance (white rows, L = 1: no factor)
+            self.omega += self._batches / L * (1.0 if L == 1 else _batch_scale(T, L))
         self._tail = np.zeros((0, self.p))
         self._total = np.zeros(self.p)
         self._count = 0
         self._batches = np.zeros((self.p, self.p))
+
+
+def _batch_scale(T: int, L: int) -> float:
+    """The factor of overlapping batch means of L samples in a segment of T: T / (T - L + 1),
+    the batches cover T - L + 1 starts of the T samples; T / (T - L), the fitted residuals sum
+    to zero on the regressor (the normal equations), which takes about L / T of the batches'
+    variance away (Meketon & Schmeiser's overlapping batch means, Proc. Winter Simulation
+    Conference 1984, have the same factor)."""
+    return T / (T - L + 1) * (T / (T - L) if T > L else 1.0)

@@ -29,9 +29,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks as checks
-from .. import _core
 from .._checks import real_array
 from ..model.robot import Robot
+from .time_scaling import _parts
 
 
 @dataclass(frozen=True)
@@ -60,13 +60,12 @@ def path_torques(
         if value.shape != q.shape:
             raise ValueError(f"{name}: expected the shape of q {q.shape}, got {value.shape}")
     gravity = robot.gravity(q)
-    zeros = np.zeros_like(q)
     # rnea with zero velocity: B q_s' + g (sign(0) = 0: no Coulomb term, no viscous term).
-    momentum = robot.rnea(q, zeros, dq) - gravity
-    # The friction law's two terms (exact sign, band 0) from the C++ core, as time_scaling.py.
-    terms = _core._friction_terms(robot, dq, 0.0)
-    viscous, coulomb = terms[..., 0, :], terms[..., 1, :]
-    inertial = robot.rnea(q, dq, ddq) - gravity - viscous - coulomb
+    momentum = robot.rnea(q, np.zeros_like(q), dq) - gravity
+    # The torque split by how it scales, as uniform time scaling splits it (time_scaling._parts:
+    # g + Coulomb, viscous, the inertial rest).
+    constant, viscous, inertial = _parts(robot.rnea(q, dq, ddq), gravity, dq, robot)
+    coulomb = constant - gravity
     if not friction:
         viscous, coulomb = np.zeros_like(q), np.zeros_like(q)
     return PathTorques(inertial, momentum, gravity, viscous, coulomb)

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
-from .closed_loop import Simulation, simulate
+from .closed_loop import Simulation, _number, simulate
 from .controllers import PD, ComputedTorque, PDGravity, gains
 
 #: The controllers a rehearsal runs (dynid.sim.controllers), by name.
@@ -95,11 +95,11 @@ def rehearse(
     if not callable(reference):
         raise ValueError("reference: expected a function t -> (q_d, qd_d, qdd_d)")
     n = robot.n
-    rate = _positive(rate, "rate")
-    bandwidth = _positive(bandwidth, "bandwidth")
-    sensor_noise = _nonnegative(sensor_noise, "sensor_noise")
+    rate = _number(rate, "rate", positive=True)
+    bandwidth = _number(bandwidth, "bandwidth", positive=True)
+    sensor_noise = _number(sensor_noise, "sensor_noise", positive=False)
     dt = 1.0 / rate
-    periods = max(1, round(_positive(duration, "duration") * rate))
+    periods = max(1, round(_number(duration, "duration", positive=True) * rate))
     model = robot if controller_model is None else controller_model
     q0, qd0, _ = (np.asarray(v, dtype=float) for v in reference(np.zeros(1)))
     q0, qd0 = q0.reshape(-1), qd0.reshape(-1)
@@ -157,19 +157,3 @@ def rehearse(
         "tracking_error_max": np.abs(q_d - run.q).max(axis=0).tolist(),
     }
     return Rehearsal(run.t, run.q_measured, tau, run, kp, kd, settings)
-
-
-def _positive(value: Any, name: str) -> float:
-    number = _nonnegative(value, name)
-    if number == 0.0:
-        raise ValueError(f"{name}: expected a finite number > 0, got {value!r}")
-    return number
-
-
-def _nonnegative(value: Any, name: str) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
-        raise ValueError(f"{name}: expected a finite number, got {value!r}")
-    number = float(value)
-    if not np.isfinite(number) or number < 0.0:
-        raise ValueError(f"{name}: expected a finite number >= 0, got {value!r}")
-    return number
