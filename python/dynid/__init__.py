@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     from .errors import PhysicalIdentificationError
     from .excitation import FourierTrajectory, optimize_excitation
     from .export.result_files import load_result, save_result
+    from .identification.closed_chain_identification import identify_closed_chain
     from .identification.drive_gains import DriveGainIdentification, identify_drive_gains
     from .identification.elastic_identification import DriveIdentification, identify_drives
     from .identification.from_controller import (
@@ -57,7 +58,9 @@ if TYPE_CHECKING:
     from .logs.preparation import prepare_log
     from .model import models
     from .model.bounds import DynamicBounds, dynamic_bounds
+    from .model.closed_chain import ClosedChain
     from .model.elastic import ElasticRobot
+    from .model.loop_closures import LinearClosure, PointClosure
     from .model.model_files import load_model, save_model
     from .motion.time_scaling import (
         scale_motion,
@@ -106,6 +109,10 @@ _LAZY = {
     "VirtualController": ".sim",
     "simulate": ".sim",
     "DynamicBounds": ".model.bounds",
+    "ClosedChain": ".model.closed_chain",
+    "LinearClosure": ".model.loop_closures",
+    "PointClosure": ".model.loop_closures",
+    "identify_closed_chain": ".identification.closed_chain_identification",
     "ElasticRobot": ".model.elastic",
     "elastic": ".model.elastic",
     "DriveGainIdentification": ".identification.drive_gains",
@@ -128,6 +135,7 @@ _LAZY = {
 # that it lists every name of _LAZY.
 __all__ = [
     "BaseParameters",
+    "ClosedChain",
     "DriveGainIdentification",
     "DriveIdentification",
     "DynamicBounds",
@@ -136,12 +144,14 @@ __all__ = [
     "IdentifiedModel",
     "LeastSquaresAccumulator",
     "LeastSquaresResult",
+    "LinearClosure",
     "Log",
     "LogIdentification",
     "MomentumObserver",
     "PayloadEstimate",
     "PhysicalIdentificationError",
     "PhysicalResult",
+    "PointClosure",
     "RankDeficientError",
     "RecursiveLeastSquares",
     "Robot",
@@ -156,6 +166,7 @@ __all__ = [
     "get_cmake_dir",
     "get_include",
     "get_threads",
+    "identify_closed_chain",
     "identify_drive_gains",
     "identify_drives",
     "identify_from_controller",

@@ -83,8 +83,11 @@ def base_parameters(
     """Base parameters of ``robot`` for the torque, gravity or inertia-stack regressor.
 
     ``rotor`` and ``friction`` append the Ia and Fv/Fs columns as in :meth:`Robot.regressor`
-    (the gravity regressor has neither; the inertia regressor has no friction).
+    (the gravity regressor has neither; the inertia regressor has no friction). A
+    :class:`dynid.ClosedChain` answers with its own :meth:`~dynid.ClosedChain.base_parameters`.
     """
+    if not isinstance(robot, Robot) and type(robot).__name__ == "ClosedChain":
+        return robot.base_parameters(kind, rotor=rotor, friction=friction)
     checks.robot(robot)
     if not isinstance(kind, str) or kind not in KINDS:
         raise ValueError(f"kind: expected one of {KINDS}, got {kind!r}")
@@ -140,6 +143,18 @@ def _compute(robot: Robot, kind: str, rotor: bool, friction: bool) -> BaseParame
     samples = max(20, (4 * columns) // rows_per_sample + 1)
     W = stacked_regressor(robot, kind, rotor, friction, samples)
 
+    return from_stacked_regressor(
+        W, robot.parameter_names(rotor, friction), kind=kind, rotor=rotor, friction=friction
+    )
+
+
+def from_stacked_regressor(
+    W: NDArray[np.float64], names_std: list[str], *, kind: str, rotor: bool, friction: bool
+) -> BaseParameters:
+    """Base parameters from a regressor stacked on random samples (rows, P), P = len(names_std):
+    the greedy left-to-right column selection and the regrouping of the module docstring. Any
+    model linear in its standard parameters uses it (a serial robot, a closed chain)."""
+    columns = W.shape[1]
     norms = np.linalg.norm(W, axis=0)
     nonzero = norms > RANK_TOLERANCE * norms.max()
     scaled = np.where(nonzero, W / np.where(nonzero, norms, 1.0), 0.0)
@@ -160,7 +175,6 @@ def _compute(robot: Robot, kind: str, rotor: bool, friction: bool) -> BaseParame
     beta[np.arange(p), independent] = 1.0
     beta[:, dependent] = T
 
-    names_std = robot.parameter_names(rotor, friction)
     expressions = [linear_expression(row, names_std) for row in beta]
     names = [
         names_std[k] + ("R" if np.count_nonzero(beta[j]) > 1 else "")

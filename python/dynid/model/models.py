@@ -1,5 +1,6 @@
 """Ready-made robot models: the KUKA LWR-IV, the lecture's planar 2R, the PUMA 560, the Franka
-Emika Panda (Gaz et al. 2019) and the Universal Robots UR5 and UR10 (from their URDFs).
+Emika Panda (Gaz et al. 2019) and the Universal Robots UR5 and UR10 (from their URDFs), and the
+lecture's closed-chain parallelogram robot (``planar_parallelogram``, a :class:`dynid.ClosedChain`).
 
 Each factory returns a fresh :class:`dynid.Robot` built with ``Robot.from_dh``.
 Units are SI, angles in radians, standard inertial parameters as in docs/conventions.md,
@@ -15,9 +16,18 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
+from .parallelogram import planar_parallelogram
 from .robot import Robot
 
-__all__ = ["kuka_lwr4", "panda", "planar_2r", "puma560", "ur5", "ur10"]
+__all__ = [
+    "kuka_lwr4",
+    "panda",
+    "planar_2r",
+    "planar_parallelogram",
+    "puma560",
+    "ur5",
+    "ur10",
+]
 
 _DEG = np.pi / 180.0
 
