@@ -381,3 +381,32 @@ def test_identification_from_positions_only() -> None:
         )
     with pytest.raises(ValueError, match=r"chain: expected a dynid\.ClosedChain"):
         dynid.identify_closed_chain(log, dynid.models.planar_2r())
+
+
+def test_point_closure_refuses_a_singular_configuration() -> None:
+    """The parallelogram folded flat (q1 = q2): links 3 and 4 are collinear with 1 and 2, the
+    passive angles are not determined by the loop."""
+    chain = dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.4)
+    assembly = chain.tree_motion(np.array([0.3, 1.8])).y[0]
+    general = ClosedChain(
+        chain.branches,
+        PointClosure(between=(0, 1), actuated=[0, 2], assembly=assembly),
+        links=chain.links,
+    )
+    for flat in ([1.0, 1.0], [1.0, 1.0 + 1e-9]):
+        with pytest.raises(ValueError, match=r"q: the (loop|passive joints)"):
+            general.gravity(flat)
+    # Close to flat the solution stays on the parallelogram's branch (Newton alone, from the
+    # previous step, jumped to the crossed "anti-parallelogram" there: G off by 10).
+    near = np.array([[1.0, 1.003], [1.0, 1.0002], [2.0, 1.9999]])
+    np.testing.assert_allclose(general.tree_motion(near).G, chain.tree_motion(near).G, atol=1e-10)
+
+
+def test_the_docs_example_runs() -> None:
+    """The first example of docs/closed_chains.md, as written."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "closed_chains.md").read_text("utf-8")
+    code = re.findall(r"^```python\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)[0]
+    exec(compile(code, "docs/closed_chains.md", "exec"), {})
