@@ -45,15 +45,6 @@ SINGULAR_CONDITION = 1e8
 CONTINUATION_STEP = 0.25
 
 
-class TreeMotion(Protocol):
-    """What a closure returns: the tree's positions, velocities, accelerations and G."""
-
-    y: NDArray[np.float64]
-    yd: NDArray[np.float64]
-    ydd: NDArray[np.float64]
-    G: NDArray[np.float64]
-
-
 class Closure(Protocol):
     """The map from independent joint motion to the spanning tree's joint motion."""
 
