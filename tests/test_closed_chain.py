@@ -522,3 +522,15 @@ def test_the_turret_arm_conserves_energy() -> None:
     swing = np.ptp(chain.potential_energy(q))
     assert swing > 1.0
     assert np.abs(energy - energy[0]).max() < 1e-8 * swing
+
+
+def test_branches_and_links_are_checked() -> None:
+    chain = dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.4)
+    other = chain.branches[1].copy()
+    other.gravity_vector = [0.0, 0.0, -9.81]
+    with pytest.raises(ValueError, match="same gravity"):
+        ClosedChain([chain.branches[0], other], chain.closure)
+    with pytest.raises(ValueError, match="links: expected"):
+        ClosedChain(chain.branches, chain.closure, links=[("a", 0)])
+    with pytest.raises(ValueError, match="links: expected distinct"):
+        ClosedChain(chain.branches, chain.closure, links=[(0, 0), (0, 0), (1, 0), (1, 1)])

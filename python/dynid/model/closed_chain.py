@@ -43,11 +43,11 @@ class ClosedChain:
 
     ``links`` numbers the bodies: ``links[k] = (branch, index)`` is the chain's link k + 1 (the
     default: the branches' links in order). A tree link left out of ``links`` must be massless
-    (all 10 parameters zero): a copy of a trunk joint that lets a second branch start on a
-    moving link (the loop of a parallelogram between joints 2 and 3 hangs from the turret; the
-    closure ties the copy's angle to the trunk's, docs/closed_chains.md). The standard parameter
-    vector is the links' 10
-    parameters each in that order (as :meth:`dynid.Robot.parameter_vector`), then the drive terms
+    (all 10 parameters zero, and kept so: the regressor has no columns for it): a copy of a trunk
+    joint that lets a second branch start on a moving link (the loop of a parallelogram between
+    joints 2 and 3 hangs from the turret; the closure ties the copy's angle to the trunk's,
+    docs/closed_chains.md). The standard parameter vector is the links' 10 parameters each in
+    that order (as :meth:`dynid.Robot.parameter_vector`), then the drive terms
     of the n independent joints: Ia, then Fv, then Fs. The branches must have no drive terms of
     their own (the tree's passive joints are frictionless and motorless here).
 
@@ -73,6 +73,9 @@ class ClosedChain:
                     f"branches[{k}]: drive terms belong to the closed chain (Ia, Fv, Fs), "
                     "not to a branch"
                 )
+        gravity = self.branches[0].gravity_vector
+        if any(not np.array_equal(b.gravity_vector, gravity) for b in self.branches):
+            raise ValueError("branches: every branch needs the same gravity vector")
         self.tree_dof = sum(b.n for b in self.branches)
         if closure.tree_dof != self.tree_dof:
             raise ValueError(
@@ -82,7 +85,10 @@ class ClosedChain:
         self.closure = closure
         self.n = int(closure.dof)
         default = [(k, i) for k, b in enumerate(self.branches) for i in range(b.n)]
-        self.links = tuple((int(k), int(i)) for k, i in (default if links is None else links))
+        try:
+            self.links = tuple((int(k), int(i)) for k, i in (default if links is None else links))
+        except (TypeError, ValueError):
+            raise ValueError(f"links: expected (branch, index) pairs among {default}") from None
         if len(set(self.links)) != len(self.links) or not set(self.links) <= set(default):
             raise ValueError(f"links: expected distinct (branch, index) pairs among {default}")
         for k, i in sorted(set(default) - set(self.links)):
@@ -98,7 +104,7 @@ class ClosedChain:
             else tuple(checks.names(joint_names, "joint_names", self.n))
         )
         self._drive_terms = {name: np.zeros(self.n) for name in ("Ia", "Fv", "Fs")}
-        self.gravity_vector = self.branches[0].gravity_vector
+        self.gravity_vector = gravity
         self._edges = np.cumsum([0] + [b.n for b in self.branches])
         # Column j of the tree's stacked regressor (branches in order) is column _order[j] of the
         # chain's (links in chain order): the permutation from branch order to link numbers.
