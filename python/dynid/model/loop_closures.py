@@ -253,7 +253,7 @@ class PointClosure:
         """Solve the loop equations for the passive joints of ``y`` in place."""
         for _ in range(MAX_ITERATIONS):
             error, A = self._constraint(branches, y)
-            worst = np.max(np.abs(error), initial=0.0)
+            worst = float(np.max(np.abs(error), initial=0.0))
             if worst < CLOSURE_TOLERANCE:
                 return
             # Newton on the passive joints: A_p dy_p = -error
