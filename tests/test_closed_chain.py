@@ -286,7 +286,7 @@ def test_five_bar_conserves_energy() -> None:
 
 def test_point_closure_refuses_a_configuration_that_cannot_close() -> None:
     chain = five_bar()
-    with pytest.raises(ValueError, match="q: the loop does not close"):
+    with pytest.raises(ValueError, match="q: the loop cannot be closed"):
         chain.rnea([np.pi, 0.0], [0.0, 0.0], [0.0, 0.0])  # the first links point apart: 1.4 m gap
 
 
@@ -394,7 +394,7 @@ def test_point_closure_refuses_a_singular_configuration() -> None:
         links=chain.links,
     )
     for flat in ([1.0, 1.0], [1.0, 1.0 + 1e-9]):
-        with pytest.raises(ValueError, match=r"q: the (loop|passive joints)"):
+        with pytest.raises(ValueError, match=r"q: the loop"):
             general.gravity(flat)
     # Close to flat the solution stays on the parallelogram's branch (Newton alone, from the
     # previous step, jumped to the crossed "anti-parallelogram" there: G off by 10).

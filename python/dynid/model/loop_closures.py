@@ -39,7 +39,7 @@ ROUNDING_ERROR = 1e-10
 #: ... or gives up after this many iterations (quadratic convergence needs ~5 from a near guess).
 MAX_ITERATIONS = 50
 #: The continuation's steps are halved up to this many times when a step jumps branch.
-REFINEMENTS = 4
+REFINEMENTS = 6
 #: A step's passive motion may differ from the trapezoid rule on its end tangents by this fraction.
 JUMP_FRACTION = 0.1
 #: A passive-joint constraint Jacobian worse conditioned than this is a singular configuration:
@@ -178,14 +178,21 @@ class PointClosure:
         base_steps = max(
             1, int(np.ceil(np.max(np.abs(near - start), initial=0.0) / CONTINUATION_STEP))
         )
+        # Samples whose path jumps branch are followed again with twice as many steps, alone.
+        followed = np.empty((T, m))
+        pending = np.arange(T)
         for refinement in range(REFINEMENTS + 1):
-            followed = self._continuation(branches, near, base_steps * 2**refinement)
-            if followed is not None:
+            y_part, jumped = self._continuation(branches, near[pending], base_steps * 2**refinement)
+            followed[pending] = y_part
+            pending = pending[jumped]
+            if pending.size == 0:
                 break
         else:
             raise ValueError(
-                "q: the passive joints could not be followed from the assembly without jumping "
-                "to another assembly mode (the path passes through or near a singularity)"
+                "q: the loop cannot be closed along the path from the assembly: outside the "
+                "mechanism's workspace, or through or near a singularity where the passive joints "
+                f"would jump to another assembly mode ({pending.size} of {T} samples, the first "
+                f"at q = {q[pending[0]].tolist()})"
             )
         y = followed
         y[:, self.actuated] = q
@@ -212,9 +219,10 @@ class PointClosure:
 
     def _continuation(
         self, branches: Sequence[Robot], q: NDArray[np.float64], steps: int
-    ) -> NDArray[np.float64] | None:
-        """The tree positions at q, followed from the assembly in ``steps`` steps; None when a
-        step's passive motion disagrees with the tangents at its ends (a jump of branch).
+    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """The tree positions at q, followed from the assembly in ``steps`` steps, and which
+        samples jumped branch on the way (a step's passive motion disagreeing with the tangents
+        at its ends).
 
         Each step predicts the passive joints along the tangent (dy_p = -A_p^-1 A_a dq) and
         Newton corrects them. Without the predictor, Newton from the previous step's passive
@@ -227,19 +235,19 @@ class PointClosure:
         self._newton(branches, y)
         dq = (q - start) / steps
         tangent = self._tangent(branches, y, dq)
+        jumped = np.zeros(q.shape[0], dtype=bool)
         for step in range(steps):
             before = y[:, self.passive].copy()
             y[:, self.actuated] = q if step == steps - 1 else start + dq * (step + 1)
             y[:, self.passive] += tangent
-            self._newton(branches, y)
+            self._newton(branches, y, jumped)
             moved = y[:, self.passive] - before
             tangent_after = self._tangent(branches, y, dq)
             mismatch = np.abs(moved - 0.5 * (tangent + tangent_after))
             scale = np.maximum(np.abs(moved), np.maximum(np.abs(tangent), np.abs(tangent_after)))
-            if np.any(mismatch > JUMP_FRACTION * scale + 1e-12):
-                return None
+            jumped |= np.any(mismatch > JUMP_FRACTION * scale + 1e-12, axis=1)
             tangent = tangent_after
-        return y
+        return y, jumped
 
     def _tangent(
         self, branches: Sequence[Robot], y: NDArray[np.float64], dq: NDArray[np.float64]
@@ -249,23 +257,43 @@ class PointClosure:
         step = -_solve(A[:, :, self.passive], A[:, :, self.actuated] @ dq[..., None])
         return np.where(np.isfinite(step[..., 0]), step[..., 0], 0.0)
 
-    def _newton(self, branches: Sequence[Robot], y: NDArray[np.float64]) -> None:
-        """Solve the loop equations for the passive joints of ``y`` in place."""
+    def _newton(
+        self,
+        branches: Sequence[Robot],
+        y: NDArray[np.float64],
+        given_up: NDArray[np.bool_] | None = None,
+    ) -> None:
+        """Solve the loop equations for the passive joints of ``y`` in place. Samples marked in
+        ``given_up`` (already off their branch, to be followed again) are marked there when they
+        do not converge instead of raising."""
         for _ in range(MAX_ITERATIONS):
             error, A = self._constraint(branches, y)
-            worst = float(np.max(np.abs(error), initial=0.0))
-            if worst < CLOSURE_TOLERANCE:
+            size = np.max(np.abs(error), axis=1, initial=0.0)
+            if given_up is not None:
+                size[given_up] = 0.0
+            if np.all(size < CLOSURE_TOLERANCE):
                 return
             # Newton on the passive joints: A_p dy_p = -error
             step = _solve(A[:, :, self.passive], -error[..., None])[..., 0]
-            if not np.all(np.isfinite(step)):
+            stuck = ~np.all(np.isfinite(step), axis=1)
+            if given_up is not None:
+                given_up |= stuck
+                step[given_up] = 0.0
+            elif stuck.any():
                 break
             # At the rounding floor (large angles after many turns, a large mechanism) the error
             # stops falling below CLOSURE_TOLERANCE while the steps vanish: converged.
             floor = ROUNDING_STEP * (1.0 + np.abs(y[:, self.passive]))
-            if worst < ROUNDING_ERROR and np.all(np.abs(step) <= floor):
+            if np.all(
+                (size < CLOSURE_TOLERANCE)
+                | ((size < ROUNDING_ERROR) & np.all(np.abs(step) <= floor, axis=1))
+            ):
                 return
             y[:, self.passive] += step
+        if given_up is not None:
+            error = self._constraint(branches, y)[0]
+            given_up |= ~(np.max(np.abs(error), axis=1, initial=0.0) < ROUNDING_ERROR)
+            return
         worst = float(np.nanmax(np.abs(self._constraint(branches, y)[0])))
         raise ValueError(
             f"q: the loop does not close (error {worst:.3g} m after Newton's method): the "
