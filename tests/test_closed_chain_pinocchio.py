@@ -200,10 +200,12 @@ def _random_parallelogram(rng: np.random.Generator, decoupled: bool) -> Parallel
 PARALLELOGRAMS = [(seed, decoupled) for seed in range(3) for decoupled in (False, True)]
 
 
-def _close(got: np.ndarray, reference: np.ndarray, tol: float = TOL) -> None:
-    """|got - reference| <= tol * max |reference| (entrywise), with the numbers on failure."""
+def _close(got: object, reference: object, tol: float = TOL, scale: float | None = None) -> None:
+    """|got - reference| <= tol * scale (entrywise), the scale by default the reference's
+    largest entry; the numbers in the message on failure."""
     got, reference = np.asarray(got), np.asarray(reference)
-    scale = max(float(np.max(np.abs(reference))), 1e-300)
+    if scale is None:
+        scale = float(np.max(np.abs(reference)))
     error = float(np.max(np.abs(got - reference)))
     assert error <= tol * scale, f"error {error:.3e} vs scale {scale:.3e} (tol {tol:g} relative)"
 
@@ -270,28 +272,44 @@ def test_parallelogram_rnea_is_the_torque_the_constrained_tree_needs(
     for k in range(len(q)):
         _close(chain.rnea(q[k], qd[k], qdd[k]), reference[k])
     _close(chain.rnea(q, qd, qdd), reference)
+    # the closed chain's regressor G^T Y_tree times its standard parameters
+    _close(chain.regressor(q, qd, qdd) @ chain.parameter_vector(), reference)
+
+
+def _check_terms(
+    chain: dynid.ClosedChain, tree: Tree, q: np.ndarray, qd: np.ndarray, y: np.ndarray
+) -> np.ndarray:
+    """M, g, c as the KKT model implies them (u = M qdd + c + g, affine in qdd), T and U of the
+    tree at the loop's state from Pinocchio; returns the KKT M."""
+    yd, rest = _velocity(tree, y, qd), np.zeros(4)
+    g = _inverse(tree, y, rest, np.zeros(2))
+    M = np.column_stack([_inverse(tree, y, rest, e) - g for e in np.eye(2)])
+    c = _inverse(tree, y, yd, np.zeros(2)) - g
+    _close(chain.mass_matrix(q), M)
+    _close(chain.gravity(q), g)
+    # c's scale: M qd^2 (c vanishes in the decoupled design, notes p. 9, up to rounding)
+    _close(chain.coriolis(q, qd), c, scale=float(np.max(np.abs(M)) * qd @ qd))
+    T, U = _energy(tree, y, yd)
+    _close(chain.kinetic_energy(q, qd), T, 1e-12)
+    # U's scale: g0 sum m_i (1 m); U itself may pass through 0
+    mass = sum(inertia.mass for inertia in tree.model.inertias)
+    _close(chain.potential_energy(q), U, 1e-12, scale=G0 * mass)
+    return M
 
 
 @pytest.mark.parametrize(("seed", "decoupled"), PARALLELOGRAMS)
-def test_parallelogram_mass_matrix_gravity_and_energies(seed: int, decoupled: bool) -> None:
-    """M and g as the KKT model implies them (u = M qdd + c + g is affine in qdd), T and U of
-    the tree at the loop's state from Pinocchio."""
+def test_parallelogram_mass_matrix_gravity_coriolis_and_energies(
+    seed: int, decoupled: bool
+) -> None:
     p = _random_parallelogram(np.random.default_rng(seed), decoupled)
     chain, tree = p.chain(), p.tree()
     q, qd, _, _ = _samples(np.random.default_rng(300 + seed), 10)
     for a, b in zip(q, qd):
-        y, yd = p.state(a, b)
-        y0 = p.state(a, np.zeros(2))[1]
-        g = _inverse(tree, y, y0, np.zeros(2))
-        M = np.column_stack([_inverse(tree, y, y0, e) - g for e in np.eye(2)])
-        _close(chain.mass_matrix(a), M)
-        _close(chain.gravity(a), g)
-        T, U = _energy(tree, y, yd)
-        _close(chain.kinetic_energy(a, b), T, 1e-12)
-        _close(chain.potential_energy(a), U, 1e-12)
+        M = _check_terms(chain, tree, a, b, p.state(a, b)[0])
         if decoupled:  # notes p. 9: B diagonal; |B12| is rounding of the B11-sized terms
             assert abs(M[0, 1]) <= 1e-12 * M[0, 0]
             assert abs(chain.mass_matrix(a)[0, 1]) <= 1e-12 * M[0, 0]
+            assert np.max(np.abs(chain.coriolis(a, b))) <= 1e-12 * M[0, 0] * b @ b
 
 
 # ---------------------------------------------------------------------------------------------
@@ -410,11 +428,9 @@ def test_five_bar_rnea_is_the_torque_the_constrained_tree_needs(seed: int) -> No
     for k in range(len(q)):
         _close(chain.rnea(q[k], qd[k], qdd[k]), reference[k])
     _close(chain.rnea(q, qd, qdd), np.array(reference))
+    _close(chain.regressor(q, qd, qdd) @ chain.parameter_vector(), np.array(reference))
     for a, b in zip(q[:5], qd[:5]):
-        y = bar.state(a)
-        T, U = _energy(tree, y, _velocity(tree, y, b))
-        _close(chain.kinetic_energy(a, b), T, 1e-12)
-        _close(chain.potential_energy(a), U, 1e-12)
+        _check_terms(chain, tree, a, b, bar.state(a))
 
 
 # ---------------------------------------------------------------------------------------------
