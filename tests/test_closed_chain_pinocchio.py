@@ -37,7 +37,7 @@ ACTUATED = [0, 2]  # the tree's base joints, branch 1's then branch 2's: their a
 PASSIVE = [1, 3]
 # Relative tolerance of the dynamics (to the largest entry of the reference): the maths is exact,
 # but the reference solves a 6 x 6 KKT system (and for rnea differences two of its solutions)
-# and dynid's five-bar stops Newton at a 1e-13 m loop error; measured worst over 400 random
+# and dynid's five-bar stops Newton at a 1e-13 m loop error; measured worst over 200-400 random
 # samples: 9e-14 (parallelogram), 7e-13 (five-bar).
 TOL = 1e-11
 
@@ -227,7 +227,7 @@ def test_the_reference_is_the_notes_parallelogram() -> None:
     p = _random_parallelogram(np.random.default_rng(7), decoupled=False)
     tree = p.tree()
     m, Ic, lc, l1, l2 = np.array(p.masses), np.array(p.inertias), np.array(p.com), p.l1, p.l2
-    for q in np.random.default_rng(8).uniform(-np.pi, np.pi, (5, 2)):
+    for q in _samples(np.random.default_rng(8), 5)[0]:
         y, yd = p.state(q, np.zeros(2))
         c1, c2 = _closure_points(tree, y)
         assert np.max(np.abs(c1 - c2)) <= 1e-15
@@ -494,7 +494,8 @@ def _balanced(p: Parallelogram, decoupled: bool) -> Parallelogram:
 def test_parallelogram_free_motion_is_the_constrained_trees(decoupled: bool) -> None:
     """Under gravity, every rest configuration has q2 - q1 = 0 or pi (g depends on cos q1 and
     cos q2 only), where the cut tree is singular: with link 2 balanced, link 1 swings about
-    -pi/2 while link 2 stays near 0, and the parallelogram keeps away from flattening."""
+    -pi/2 while link 2 stays near 0, and the parallelogram keeps away from flattening (in the
+    decoupled design link 2 then turns at its constant initial rate, notes p. 10)."""
     p = _balanced(_random_parallelogram(np.random.default_rng(3), decoupled=False), decoupled)
     chain, tree = p.chain(), p.tree()
     y0, yd0 = p.state(np.array([-np.pi / 2 + 0.6, 0.0]), np.array([0.0, 0.3]))
@@ -522,10 +523,11 @@ def test_five_bar_keeps_its_assembly_mode_near_the_inner_boundary() -> None:
     """On the straight path from the assembly to q the couplers never fold onto each other
     (|P2 - P1| stays >= 15 mm above |b1 - b2|, cond(A_p) <= 29 at q), so the assembly's mode
     continues to q: C on the same side of P1 -> P2. dynid (e0c3690) puts C 0.77 m away, at
-    (-0.362, -0.710) instead of (0.346, -1.003); the free motion of this bar from
-    q0 + (0.15, -0.1), qd = (0.5, 0.3) reaches q = (-1.19424057, -1.74661435) at t ~ 0.3 s,
-    where dynid raises "the loop does not close (error 1.92e-13 m)" after Newton wandered to
-    passive angles of -5649 and -5215 rad."""
+    (-0.362, -0.710) instead of (0.346, -1.003). The KKT model's free motion of this bar from
+    q0 + (0.15, -0.1), qd = (0.5, 0.3) passes q = (-1.19424057, -1.74661435) at t = 0.59 s
+    (cond(A_p) = 47.5), where dynid's own integration stops: "the loop does not close (error
+    1.92e-13 m)", Newton having wandered to passive angles of -5649 and -5215 rad; along that
+    motion dynid returns the other mode at 55 of 201 instants between t = 0.60 and 0.95 s."""
     bar = _random_five_bar(np.random.default_rng(12), hanging=True)
     chain, tree = bar.chain(), bar.tree()
     q = np.array([-1.25424057, -1.84661435])
