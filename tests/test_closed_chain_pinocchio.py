@@ -433,6 +433,36 @@ def test_five_bar_rnea_is_the_torque_the_constrained_tree_needs(seed: int) -> No
         _check_terms(chain, tree, a, b, bar.state(a))
 
 
+@pytest.mark.parametrize("mechanism", ["parallelogram", "five-bar"])
+def test_drive_terms_are_rotors_and_friction_at_the_base_joints(mechanism: str) -> None:
+    """The drive terms act on the independent joints (notes pp. 11-13): in the reference the
+    rotors are Pinocchio armature on the tree's base joints (crba adds it to M's diagonal) and
+    the friction Fv qd + Fs sign(qd) adds to the torque the loop needs."""
+    rng = np.random.default_rng(700)
+    if mechanism == "parallelogram":
+        p = _random_parallelogram(rng, decoupled=False)
+        chain, tree = p.chain(), p.tree()
+        q, qd, qdd, u = _samples(rng, 10)
+        ys = [p.state(a, np.zeros(2))[0] for a in q]
+    else:
+        bar = _random_five_bar(rng)
+        chain, tree = bar.chain(), bar.tree()
+        q, qd, qdd, u = _five_bar_samples(bar, rng, 10)
+        ys = [bar.state(a) for a in q]
+    Ia, Fv, Fs = rng.uniform(0.05, 0.5, (3, 2))
+    chain.Ia, chain.Fv, chain.Fs = Ia, Fv, Fs
+    tree.model.armature = np.array([Ia[0], 0.0, Ia[1], 0.0])
+    tree.data = tree.model.createData()
+    for y, a, b, c, w in zip(ys, q, qd, qdd, u):
+        yd, friction = _velocity(tree, y, b), Fv * b + Fs * np.sign(b)
+        _close(chain.rnea(a, b, c), _inverse(tree, y, yd, c) + friction)
+        _close(chain.forward_dynamics(a, b, w), _forward(tree, y, yd, w - friction))
+        rest = _inverse(tree, y, np.zeros(4), np.zeros(2))
+        M = np.column_stack([_inverse(tree, y, np.zeros(4), e) - rest for e in np.eye(2)])
+        _close(chain.mass_matrix(a), M)
+        _close(chain.kinetic_energy(a, b), 0.5 * b @ M @ b, 1e-12)
+
+
 # ---------------------------------------------------------------------------------------------
 # Free motion (u = 0): energy and trajectories over 1 s
 
