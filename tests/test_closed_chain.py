@@ -381,3 +381,157 @@ def test_identification_from_positions_only() -> None:
         )
     with pytest.raises(ValueError, match=r"chain: expected a dynid\.ClosedChain"):
         dynid.identify_closed_chain(log, dynid.models.planar_2r())
+
+
+def test_point_closure_refuses_a_singular_configuration() -> None:
+    """The parallelogram folded flat (q1 = q2): links 3 and 4 are collinear with 1 and 2, the
+    passive angles are not determined by the loop."""
+    chain = dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.4)
+    assembly = chain.tree_motion(np.array([0.3, 1.8])).y[0]
+    general = ClosedChain(
+        chain.branches,
+        PointClosure(between=(0, 1), actuated=[0, 2], assembly=assembly),
+        links=chain.links,
+    )
+    for flat in ([1.0, 1.0], [1.0, 1.0 + 1e-9]):
+        with pytest.raises(ValueError, match=r"q: the (loop|passive joints)"):
+            general.gravity(flat)
+    # Close to flat the solution stays on the parallelogram's branch (Newton alone, from the
+    # previous step, jumped to the crossed "anti-parallelogram" there: G off by 10).
+    near = np.array([[1.0, 1.003], [1.0, 1.0002], [2.0, 1.9999]])
+    np.testing.assert_allclose(general.tree_motion(near).G, chain.tree_motion(near).G, atol=1e-10)
+
+
+def test_the_docs_examples_run() -> None:
+    """The parallelogram and the turret examples of docs/closed_chains.md, as written."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "closed_chains.md").read_text("utf-8")
+    codes = re.findall(r"^```python\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)
+    for code in (codes[0], codes[2]):  # [1] sketches a five-bar, [3] needs a log
+        exec(compile(code, "docs/closed_chains.md", "exec"), {})
+
+
+def turret_arm(massless_loop: bool = False, seed: int = 0) -> ClosedChain:
+    """An industrial arm's parallelogram (docs/closed_chains.md, "A loop on a moving link"):
+    turret q1 about z, upper arm q2 about the horizontal shoulder axis, and the forearm driven by
+    motor 3 at the shoulder through a crank (angle q3) and a rod parallel to the upper arm. Branch
+    1 starts with a massless copy of the turret joint, tied to q1 by the closure."""
+    h, upper, forearm, lever = 0.5, 0.8, 0.9, 0.25
+    rng = np.random.default_rng(seed)
+    g = (0.0, 0.0, -9.81)
+
+    def tool(x: float) -> np.ndarray:
+        T = np.eye(4)
+        T[0, 3] = x
+        return T
+
+    rows = [[0.0, 0.0, h, 0.0], [0.0, np.pi / 2, 0.0, 0.0]]
+    arm = dynid.Robot.from_dh(
+        [*rows, [upper, 0.0, 0.0, 0.0]], convention="modified", gravity=g, tool=tool(-lever)
+    )
+    loop = dynid.Robot.from_dh(
+        [*rows, [lever, 0.0, 0.0, 0.0]], convention="modified", gravity=g, tool=tool(upper)
+    )
+
+    def body(robot: dynid.Robot, i: int, mass: float, length: float) -> None:
+        izz = mass * length**2 / 12
+        com = (rng.uniform(0.2, 0.6) * length, rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02))
+        tensor = np.diag([0.05 * izz + 1e-3, izz, izz]) + 1e-5 * (1 - np.eye(3))
+        robot.set_link(i, mass, com, tensor)
+
+    body(arm, 0, 8.0, 0.3)
+    body(arm, 1, 6.0, upper)
+    body(arm, 2, 4.0, forearm)
+    if not massless_loop:
+        body(loop, 1, 1.0, lever)
+        body(loop, 2, 0.7, upper)
+    # tree [turret, upper arm, elbow (rel.), turret copy, crank, rod (rel. to the crank)]:
+    # the forearm points opposite the crank (theta3 = q3 - q2 - pi), the rod along the upper arm.
+    closure = LinearClosure(
+        [[1, 0, 0], [0, 1, 0], [0, -1, 1], [1, 0, 0], [0, 0, 1], [0, 1, -1]],
+        offset=[0, 0, -np.pi, 0, 0, 0],
+    )
+    links = [(0, 0), (0, 1), (0, 2)] + ([] if massless_loop else [(1, 1), (1, 2)])
+    return ClosedChain([arm, loop], closure, links=links, name="arm with a parallelogram")
+
+
+def test_a_parallelogram_hanging_from_the_turret() -> None:
+    chain = turret_arm()
+    rng = np.random.default_rng(4)
+    q = np.array([0.3, 0.9, 2.5]) + rng.uniform(-0.5, 0.5, (30, 3))
+    qd, qdd = rng.normal(size=(2, 30, 3))
+    # the loop closes in space
+    motion = chain.tree_motion(q)
+    arm, loop = chain.branches
+    tip_arm = arm.fkine(motion.y[:, :3])[:, :3, 3]
+    tip_loop = loop.fkine(motion.y[:, 3:])[:, :3, 3]
+    assert np.abs(tip_arm - tip_loop).max() < 1e-14
+    # the general closure, solving the turret copy, the elbow and the rod from the 3-D
+    # coincidence of the rod's tip with the forearm's lever, gives the same dynamics
+    general = ClosedChain(
+        chain.branches,
+        PointClosure(
+            between=(0, 1),
+            actuated=[0, 1, 4],
+            assembly=chain.tree_motion(q[0]).y[0] + 0.05,
+            components=(0, 1, 2),
+        ),
+        links=chain.links,
+    )
+    tau = chain.rnea(q, qd, qdd)
+    np.testing.assert_allclose(general.rnea(q, qd, qdd), tau, atol=1e-11 * np.abs(tau).max())
+    np.testing.assert_allclose(
+        general.regressor(q, qd, qdd), chain.regressor(q, qd, qdd), atol=1e-11 * np.abs(tau).max()
+    )
+    # the massless copy brings no parameters: 5 links, 50 standard parameters
+    assert len(chain.parameter_vector()) == 50
+    np.testing.assert_allclose(
+        chain.regressor(q, qd, qdd) @ chain.parameter_vector(), tau, atol=1e-12 * np.abs(tau).max()
+    )
+    with pytest.raises(ValueError, match="massless"):
+        ClosedChain(chain.branches, chain.closure, links=[(0, 0), (0, 1), (0, 2), (1, 1)])
+
+
+def test_a_massless_parallelogram_is_the_serial_arm_driven_through_it() -> None:
+    """Without crank and rod masses the mechanism is the serial arm, with the elbow driven from
+    the shoulder: tau_chain = G_s^T tau_serial(q1, q2, q3 - q2 - pi), G_s the elbow's map."""
+    chain = turret_arm(massless_loop=True)
+    serial = chain.branches[0]
+    rng = np.random.default_rng(8)
+    q = rng.uniform(-np.pi, np.pi, (30, 3))
+    qd, qdd = rng.normal(size=(2, 30, 3))
+    theta = np.stack([q[:, 0], q[:, 1], q[:, 2] - q[:, 1] - np.pi], axis=1)
+    Gs = np.array([[1, 0, 0], [0, 1, 0], [0, -1, 1]])
+    tau_serial = serial.rnea(theta, qd @ Gs.T, qdd @ Gs.T)
+    np.testing.assert_allclose(
+        chain.rnea(q, qd, qdd), tau_serial @ Gs, atol=1e-12 * np.abs(tau_serial).max()
+    )
+
+
+def test_the_turret_arm_conserves_energy() -> None:
+    chain = turret_arm()
+
+    def rhs(_t: float, x: np.ndarray) -> np.ndarray:
+        return np.concatenate([x[3:], chain.forward_dynamics(x[:3], x[3:], np.zeros(3))])
+
+    x0 = np.array([0.2, 0.8, 2.6, 1.0, -0.5, 0.8])
+    sol = solve_ivp(rhs, (0.0, 0.6), x0, method="DOP853", rtol=1e-12, atol=1e-12)
+    q, qd = sol.y[:3].T, sol.y[3:].T
+    energy = chain.kinetic_energy(q, qd) + chain.potential_energy(q)
+    swing = np.ptp(chain.potential_energy(q))
+    assert swing > 1.0
+    assert np.abs(energy - energy[0]).max() < 1e-8 * swing
+
+
+def test_branches_and_links_are_checked() -> None:
+    chain = dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.4)
+    other = chain.branches[1].copy()
+    other.gravity_vector = [0.0, 0.0, -9.81]
+    with pytest.raises(ValueError, match="same gravity"):
+        ClosedChain([chain.branches[0], other], chain.closure)
+    with pytest.raises(ValueError, match="links: expected"):
+        ClosedChain(chain.branches, chain.closure, links=[("a", 0)])
+    with pytest.raises(ValueError, match="links: expected distinct"):
+        ClosedChain(chain.branches, chain.closure, links=[(0, 0), (0, 0), (1, 0), (1, 1)])

@@ -13,7 +13,7 @@ import pytest
 
 import dynid
 from dynid.logs import load_log, save_log
-from dynid.logs.formats import detect, formats
+from dynid.logs.detection import detect, formats
 from log_writers import (
     Motion,
     simulate,

@@ -1,10 +1,9 @@
-"""Which log formats exist, and which one a file is: the one home of the readers.
+"""What a log format is, and the registry of them.
 
 Each format is a :class:`LogFormat` (its name, the file name suffixes it reads, a test on the
-file's first bytes, and its reader), registered once in :mod:`dynid.logs.readers`. ``detect``
-picks the first format whose suffix matches and which recognises the file, trying the specific
-formats (a robot's own recorder, recognised by its header) before the generic ones (any CSV,
-NPZ, MATLAB), so that a UR RTDE file is read as one and not as some CSV.
+file's first bytes, and its reader), registered once in :mod:`dynid.logs.readers` with
+:func:`register`. Which format a file is: :mod:`dynid.logs.detection` (it imports the readers;
+this module does not, so that the readers can import it without a circle).
 """
 
 from __future__ import annotations
@@ -15,10 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .log_files import Log
-
-#: Bytes of a file handed to ``recognises`` (a header of 80+ RTDE names fits).
-HEAD_BYTES = 4096
+    from .log import Log
 
 
 @dataclass(frozen=True)
@@ -76,46 +72,7 @@ def register(fmt: LogFormat, *, generic: bool = False) -> LogFormat:
     return fmt
 
 
-def formats() -> list[LogFormat]:
-    """The registered formats in the order ``detect`` tries them."""
-    from . import readers  # noqa: F401  (registers the formats on first use)
-
+def registered() -> list[LogFormat]:
+    """The formats registered so far, in the order ``detect`` tries them (specific, then generic);
+    :func:`dynid.logs.detection.formats` registers dynid's own first."""
     return [*_SPECIFIC, *_GENERIC]
-
-
-def suffixes() -> list[str]:
-    """Every suffix some format reads, in the order of ``formats()`` (no repeats)."""
-    return list(dict.fromkeys(s for fmt in formats() for s in fmt.suffixes))
-
-
-def detect(path: str | Path) -> LogFormat:
-    """The format of the file ``path``: by suffix, then by its first bytes."""
-    path = Path(path)
-    suffix = DIRECTORY if path.is_dir() else path.suffix.lower()
-    candidates = [fmt for fmt in formats() if suffix in fmt.suffixes]
-    if not candidates and suffix == DIRECTORY:
-        raise ValueError(f"path: {path} is a folder; no log format reads a folder")
-    if not candidates:
-        known = [s for s in suffixes() if s != DIRECTORY]
-        own = [s for s in (".npz", ".csv") if s in known]
-        others = [s for s in known if s not in own]
-        raise ValueError(
-            f"path: unknown extension {path.suffix!r} of {path}; expected {' or '.join(own)}"
-            + (f", or {', '.join(others)}" if others else "")
-        )
-    head = "" if suffix == DIRECTORY else _head(path)
-    for fmt in candidates:
-        if fmt.recognises(path, head):
-            return fmt
-    names = ", ".join(fmt.name for fmt in candidates)
-    raise ValueError(f"{path}: not recognised as any of the {suffix} formats ({names})")
-
-
-def _head(path: Path) -> str:
-    """The file's first bytes as text, or "" when they are binary (a NUL byte, not UTF-8)."""
-    with path.open("rb") as handle:
-        raw = handle.read(HEAD_BYTES)
-    if b"\0" in raw:
-        return ""
-    # A multi-byte character may be cut at the end of the block: ignore that, not the file.
-    return raw.decode("utf-8", errors="ignore")

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from .log_files import Log
+from .log import Log
 
 if TYPE_CHECKING:
     from ..model.robot import Robot

@@ -20,7 +20,7 @@ from . import rest
 from . import signal as sig
 from ._iir import butterworth_lowpass, default_padding
 from .edges import EDGE_FRACTION, edge_trim
-from .log_files import SIGNALS, Log
+from .log import SIGNALS, Log
 from .timing import GAP_STEPS, measure_timing, resample_uniform, segments, uniform_grid
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .log_files import Log
+from .log import Log
 from .ros_bags import EXTRA, JOINT_STATE
 
 #: Storage formats of a ROS 2 bag: MCAP (the default since ROS 2 Iron) or SQLite 3.

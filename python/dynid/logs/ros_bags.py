@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .log_files import Log
+from .log import Log
 from .messages import name_list
 
 #: The message type read; ROS 1 bags name it ``sensor_msgs/JointState``, which rosbags reports in

@@ -17,9 +17,10 @@ p. 9: Izz1 + m1 lc1^2 + Izz3 + m3 lc3^2 + m4 l1^2, ..., m3 l2 lc3 - m4 l1 lc4), 
 :meth:`ClosedChain.base_parameters` as for a serial robot. The drive terms (rotor inertia Ia,
 viscous Fv and Coulomb Fs friction) act on the independent joints, where the motors are.
 
-Limits: the branches start at the fixed base (a loop hanging from a moving link, as the
-parallelogram of joints 2-3 on a turret, needs a tree Newton-Euler pass that dynid does not have);
-one loop per chain for :class:`~dynid.model.loop_closures.PointClosure`.
+The branches start at the fixed base; a loop hanging from a moving link (the parallelogram of
+joints 2-3 on an arm's turret) is modelled with a massless copy of the trunk's joints at the
+start of its branch, tied to the trunk by the closure (docs/closed_chains.md). One loop per
+:class:`~dynid.model.loop_closures.PointClosure`.
 """
 
 from __future__ import annotations
@@ -41,8 +42,12 @@ class ClosedChain:
     """A closed-chain robot: serial ``branches`` from the base, a ``closure`` tying their joints.
 
     ``links`` numbers the bodies: ``links[k] = (branch, index)`` is the chain's link k + 1 (the
-    default: the branches' links in order). The standard parameter vector is the links' 10
-    parameters each in that order (as :meth:`dynid.Robot.parameter_vector`), then the drive terms
+    default: the branches' links in order). A tree link left out of ``links`` must be massless
+    (all 10 parameters zero, and kept so: the regressor has no columns for it): a copy of a trunk
+    joint that lets a second branch start on a moving link (the loop of a parallelogram between
+    joints 2 and 3 hangs from the turret; the closure ties the copy's angle to the trunk's,
+    docs/closed_chains.md). The standard parameter vector is the links' 10 parameters each in
+    that order (as :meth:`dynid.Robot.parameter_vector`), then the drive terms
     of the n independent joints: Ia, then Fv, then Fs. The branches must have no drive terms of
     their own (the tree's passive joints are frictionless and motorless here).
 
@@ -68,6 +73,9 @@ class ClosedChain:
                     f"branches[{k}]: drive terms belong to the closed chain (Ia, Fv, Fs), "
                     "not to a branch"
                 )
+        gravity = self.branches[0].gravity_vector
+        if any(not np.array_equal(b.gravity_vector, gravity) for b in self.branches):
+            raise ValueError("branches: every branch needs the same gravity vector")
         self.tree_dof = sum(b.n for b in self.branches)
         if closure.tree_dof != self.tree_dof:
             raise ValueError(
@@ -77,9 +85,18 @@ class ClosedChain:
         self.closure = closure
         self.n = int(closure.dof)
         default = [(k, i) for k, b in enumerate(self.branches) for i in range(b.n)]
-        self.links = tuple((int(k), int(i)) for k, i in (default if links is None else links))
-        if sorted(self.links) != default:
-            raise ValueError(f"links: expected a permutation of {default}")
+        try:
+            self.links = tuple((int(k), int(i)) for k, i in (default if links is None else links))
+        except (TypeError, ValueError):
+            raise ValueError(f"links: expected (branch, index) pairs among {default}") from None
+        if len(set(self.links)) != len(self.links) or not set(self.links) <= set(default):
+            raise ValueError(f"links: expected distinct (branch, index) pairs among {default}")
+        for k, i in sorted(set(default) - set(self.links)):
+            if np.any(self.branches[k].parameter_vector()[10 * i : 10 * i + 10]):
+                raise ValueError(
+                    f"links: branch {k}'s link {i} is left out, so it must be massless (a copy of "
+                    "a trunk joint), but it has inertial parameters"
+                )
         self.name = str(name)
         self.joint_names = (
             tuple(f"q{j + 1}" for j in range(self.n))
@@ -87,11 +104,11 @@ class ClosedChain:
             else tuple(checks.names(joint_names, "joint_names", self.n))
         )
         self._drive_terms = {name: np.zeros(self.n) for name in ("Ia", "Fv", "Fs")}
-        self.gravity_vector = self.branches[0].gravity_vector
+        self.gravity_vector = gravity
         self._edges = np.cumsum([0] + [b.n for b in self.branches])
         # Column j of the tree's stacked regressor (branches in order) is column _order[j] of the
         # chain's (links in chain order): the permutation from branch order to link numbers.
-        self._order = np.empty(10 * self.tree_dof, dtype=int)
+        self._order = np.full(10 * self.tree_dof, -1)  # -1: a massless copy, no columns
         for number, (k, i) in enumerate(self.links):
             tree_link = self._edges[k] + i
             self._order[10 * tree_link : 10 * tree_link + 10] = np.arange(10) + 10 * number
@@ -304,13 +321,15 @@ class ClosedChain:
         """G^T times the tree's regressor (block diagonal over the branches), in link order."""
         T = states[0].shape[0]
         split = [self._per_branch(s) for s in states]
-        Y = np.zeros((T, self.n, 10 * self.tree_dof))
+        Y = np.zeros((T, self.n, 10 * len(self.links)))
         for k, b in enumerate(self.branches):
             part = slice(self._edges[k], self._edges[k + 1])
+            order = self._order[10 * self._edges[k] : 10 * self._edges[k + 1]]
+            kept = order >= 0
+            if not kept.any():
+                continue
             Yb = getattr(b, method)(*(s[k] for s in split)).reshape(T, b.n, 10 * b.n)
-            Y[:, :, self._order[10 * self._edges[k] : 10 * self._edges[k + 1]]] = self._project(
-                G[:, part, :], Yb
-            )
+            Y[:, :, order[kept]] = self._project(G[:, part, :], Yb[:, :, kept])
         return Y
 
     def _with_drive(

@@ -34,20 +34,15 @@ from .robot import Robot
 CLOSURE_TOLERANCE = 1e-13
 #: ... or gives up after this many iterations (quadratic convergence needs ~5 from a near guess).
 MAX_ITERATIONS = 50
+#: The continuation's steps are halved up to this many times when a step jumps branch.
+REFINEMENTS = 4
+#: A step's passive motion may differ from the trapezoid rule on its end tangents by this fraction.
+JUMP_FRACTION = 0.1
 #: A passive-joint constraint Jacobian worse conditioned than this is a singular configuration:
-#: the passive velocities (G) would carry a relative error above ~1e-6.
-SINGULAR_CONDITION = 1e10
+#: the passive velocities (G) would carry a relative error above ~cond * eps = 2e-8.
+SINGULAR_CONDITION = 1e8
 #: The largest step of the independent joints between two Newton solves of the continuation [rad].
 CONTINUATION_STEP = 0.25
-
-
-class TreeMotion(Protocol):
-    """What a closure returns: the tree's positions, velocities, accelerations and G."""
-
-    y: NDArray[np.float64]
-    yd: NDArray[np.float64]
-    ydd: NDArray[np.float64]
-    G: NDArray[np.float64]
 
 
 class Closure(Protocol):
@@ -169,17 +164,19 @@ class PointClosure:
         qdd: NDArray[np.float64] | None = None,
     ) -> Motion:
         T, m = q.shape[0], self.tree_dof
-        y = np.empty((T, m))
-        y[:] = self.assembly
         start = self.assembly[self.actuated]
-        # Continuation from the assembly: the independent joints move there in steps of at most
-        # CONTINUATION_STEP rad, Newton following the passive joints, so that the solution stays
-        # on the assembly's branch (a parallelogram's Newton from a far guess can land on the
-        # crossed "anti-parallelogram" branch instead).
-        steps = max(1, int(np.ceil(np.max(np.abs(q - start), initial=0.0) / CONTINUATION_STEP)))
-        for step in range(1, steps + 1):
-            y[:, self.actuated] = start + (q - start) * (step / steps)
-            self._newton(branches, y)
+        base_steps = max(
+            1, int(np.ceil(np.max(np.abs(q - start), initial=0.0) / CONTINUATION_STEP))
+        )
+        for refinement in range(REFINEMENTS + 1):
+            y = self._continuation(branches, q, base_steps * 2**refinement)
+            if y is not None:
+                break
+        else:
+            raise ValueError(
+                "q: the passive joints could not be followed from the assembly without jumping "
+                "to another assembly mode (the path passes through or near a singularity)"
+            )
         _, A = self._constraint(branches, y)
         A_a, A_p = A[:, :, self.actuated], A[:, :, self.passive]
         if np.any(np.linalg.cond(A_p) > SINGULAR_CONDITION):
@@ -201,6 +198,45 @@ class PointClosure:
             ydd[:, self.passive] -= np.linalg.solve(A_p, bias[..., None])[..., 0]
         return Motion(y, yd, ydd, G)
 
+    def _continuation(
+        self, branches: Sequence[Robot], q: NDArray[np.float64], steps: int
+    ) -> NDArray[np.float64] | None:
+        """The tree positions at q, followed from the assembly in ``steps`` steps; None when a
+        step's passive motion disagrees with the tangents at its ends (a jump of branch).
+
+        Each step predicts the passive joints along the tangent (dy_p = -A_p^-1 A_a dq) and
+        Newton corrects them. Without the predictor, Newton from the previous step's passive
+        joints lands on another branch near a bifurcation (a parallelogram close to folding flat
+        jumps to the crossed "anti-parallelogram"); the check catches what the predictor misses:
+        on the same branch dy_p equals the trapezoid rule on the two tangents to O(dq^3)."""
+        start = self.assembly[self.actuated]
+        y = np.empty((q.shape[0], self.tree_dof))
+        y[:] = self.assembly
+        self._newton(branches, y)
+        dq = (q - start) / steps
+        tangent = self._tangent(branches, y, dq)
+        for step in range(steps):
+            before = y[:, self.passive].copy()
+            y[:, self.actuated] = q if step == steps - 1 else start + dq * (step + 1)
+            y[:, self.passive] += tangent
+            self._newton(branches, y)
+            moved = y[:, self.passive] - before
+            tangent_after = self._tangent(branches, y, dq)
+            mismatch = np.abs(moved - 0.5 * (tangent + tangent_after))
+            scale = np.maximum(np.abs(moved), np.maximum(np.abs(tangent), np.abs(tangent_after)))
+            if np.any(mismatch > JUMP_FRACTION * scale + 1e-12):
+                return None
+            tangent = tangent_after
+        return y
+
+    def _tangent(
+        self, branches: Sequence[Robot], y: NDArray[np.float64], dq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """The passive joints' first-order motion -A_p^-1 A_a dq (zero where A_p is singular)."""
+        _, A = self._constraint(branches, y)
+        step = -_solve(A[:, :, self.passive], A[:, :, self.actuated] @ dq[..., None])
+        return np.where(np.isfinite(step[..., 0]), step[..., 0], 0.0)
+
     def _newton(self, branches: Sequence[Robot], y: NDArray[np.float64]) -> None:
         """Solve the loop equations for the passive joints of ``y`` in place."""
         for _ in range(MAX_ITERATIONS):
@@ -208,8 +244,7 @@ class PointClosure:
             if np.max(np.abs(error), initial=0.0) < CLOSURE_TOLERANCE:
                 return
             # Newton on the passive joints: A_p dy_p = -error
-            with np.errstate(all="ignore"):
-                step = np.linalg.solve(A[:, :, self.passive], -error[..., None])[..., 0]
+            step = _solve(A[:, :, self.passive], -error[..., None])[..., 0]
             if not np.all(np.isfinite(step)):
                 break
             y[:, self.passive] += step
@@ -252,3 +287,13 @@ class PointClosure:
             Jdot = branches[k].jacobian_dot(parts[k], rates[k]).reshape(-1, 6, branches[k].n)
             bias += sign * np.einsum("tij,tj->ti", Jdot[:, self.components, :], rates[k])
         return bias
+
+
+def _solve(A: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Batched A^-1 b; NaN for the samples whose A is exactly singular (the callers check)."""
+    with np.errstate(all="ignore"):
+        singular = ~(np.abs(np.linalg.det(A)) > 0.0)
+        safe = np.where(singular[:, None, None], np.eye(A.shape[-1]), A)
+        x = np.asarray(np.linalg.solve(safe, b))
+    x[singular] = np.nan
+    return x

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from ..columns import index_names, matching, readable, time_scale
 from ..formats import ReadOptions
-from ..log_files import Log, check_finite
+from ..log import Log, check_finite
 from ..messages import name_list
 from ._table import Table, numbers
 

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log
+from ..log import Log
 from ._build import table_log
 from ._table import header_fields, read_table
 

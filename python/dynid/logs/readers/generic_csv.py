@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log
+from ..log import Log
 from ..messages import name_list
 from ._build import finish, table_log
 from ._table import Table, numbers, read_table

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log
+from ..log import Log
 from ._build import finish
 from .npz import keyed_arrays
 

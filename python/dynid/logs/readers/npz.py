@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from ..._checks import positive
 from ..columns import matching
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log
+from ..log import Log
 from ..messages import name_list
 from ._build import finish
 

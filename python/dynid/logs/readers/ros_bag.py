@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..formats import DIRECTORY, LogFormat, ReadOptions
-from ..log_files import Log
+from ..log import Log
 from ..ros_bags import FORMAT_NAME
 
 #: A ROS bag by its storage file (ROS 1 .bag, ROS 2 .mcap/.db3) or a ROS 2 bag's folder.

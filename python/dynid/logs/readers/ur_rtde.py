@@ -15,7 +15,7 @@ import re
 from pathlib import Path
 
 from ..formats import LogFormat, ReadOptions
-from ..log_files import Log
+from ..log import Log
 from ._build import table_log
 from ._table import header_fields, read_table
 
