@@ -32,6 +32,10 @@ from .robot import Robot
 
 #: Newton's method on the loop equations stops when the closure error is below this (m) ...
 CLOSURE_TOLERANCE = 1e-13
+#: ... or, when it cannot get there for rounding, when its steps are below ROUNDING_STEP times
+#: the passive angles and the error below ROUNDING_ERROR (m) ...
+ROUNDING_STEP = 1e-14
+ROUNDING_ERROR = 1e-10
 #: ... or gives up after this many iterations (quadratic convergence needs ~5 from a near guess).
 MAX_ITERATIONS = 50
 #: The continuation's steps are halved up to this many times when a step jumps branch.
@@ -165,18 +169,26 @@ class PointClosure:
     ) -> Motion:
         T, m = q.shape[0], self.tree_dof
         start = self.assembly[self.actuated]
+        # Whole turns of a revolute independent joint do not change the mechanism: follow the
+        # shortest path from the assembly, then put the turns back.
+        types = "".join(b.joint_types for b in branches)
+        revolute = np.array([types[j] == "R" for j in self.actuated])
+        turns = np.where(revolute, 2.0 * np.pi * np.round((q - start) / (2.0 * np.pi)), 0.0)
+        near = q - turns
         base_steps = max(
-            1, int(np.ceil(np.max(np.abs(q - start), initial=0.0) / CONTINUATION_STEP))
+            1, int(np.ceil(np.max(np.abs(near - start), initial=0.0) / CONTINUATION_STEP))
         )
         for refinement in range(REFINEMENTS + 1):
-            y = self._continuation(branches, q, base_steps * 2**refinement)
-            if y is not None:
+            followed = self._continuation(branches, near, base_steps * 2**refinement)
+            if followed is not None:
                 break
         else:
             raise ValueError(
                 "q: the passive joints could not be followed from the assembly without jumping "
                 "to another assembly mode (the path passes through or near a singularity)"
             )
+        y = followed
+        y[:, self.actuated] = q
         _, A = self._constraint(branches, y)
         A_a, A_p = A[:, :, self.actuated], A[:, :, self.passive]
         if np.any(np.linalg.cond(A_p) > SINGULAR_CONDITION):
@@ -241,12 +253,18 @@ class PointClosure:
         """Solve the loop equations for the passive joints of ``y`` in place."""
         for _ in range(MAX_ITERATIONS):
             error, A = self._constraint(branches, y)
-            if np.max(np.abs(error), initial=0.0) < CLOSURE_TOLERANCE:
+            worst = float(np.max(np.abs(error), initial=0.0))
+            if worst < CLOSURE_TOLERANCE:
                 return
             # Newton on the passive joints: A_p dy_p = -error
             step = _solve(A[:, :, self.passive], -error[..., None])[..., 0]
             if not np.all(np.isfinite(step)):
                 break
+            # At the rounding floor (large angles after many turns, a large mechanism) the error
+            # stops falling below CLOSURE_TOLERANCE while the steps vanish: converged.
+            floor = ROUNDING_STEP * (1.0 + np.abs(y[:, self.passive]))
+            if worst < ROUNDING_ERROR and np.all(np.abs(step) <= floor):
+                return
             y[:, self.passive] += step
         worst = float(np.nanmax(np.abs(self._constraint(branches, y)[0])))
         raise ValueError(
