@@ -590,9 +590,9 @@ def test_five_bar_keeps_its_assembly_mode_near_the_inner_boundary() -> None:
 @pytest.mark.xfail(
     strict=True,
     raises=ValueError,
-    reason="dynid's PointClosure (4949dc9) refuses a regular configuration 9 mm from the inner "
+    reason="dynid's PointClosure (d007fa2) refuses a regular configuration 9 mm from the inner "
     "workspace boundary: its branch-jump check still fails after REFINEMENTS = 4 halvings "
-    "(6 suffice); reported, not fixed here",
+    "(5 suffice); reported, not fixed here",
 )
 def test_five_bar_follows_its_assembly_mode_close_to_the_inner_boundary() -> None:
     """q is regular (cond(A_p) = 38, far below dynid's SINGULAR_CONDITION = 1e8) and the
