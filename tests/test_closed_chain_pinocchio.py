@@ -587,25 +587,46 @@ def test_five_bar_keeps_its_assembly_mode_near_the_inner_boundary() -> None:
     _check_assembly_mode(bar, q)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=ValueError,
-    reason="dynid's PointClosure (d007fa2) refuses a regular configuration 9 mm from the inner "
-    "workspace boundary: its branch-jump check still fails after REFINEMENTS = 4 halvings "
-    "(5 suffice); reported, not fixed here",
-)
 def test_five_bar_follows_its_assembly_mode_close_to_the_inner_boundary() -> None:
-    """q is regular (cond(A_p) = 38, far below dynid's SINGULAR_CONDITION = 1e8) and the
-    straight path from the assembly stays >= 9 mm from the boundary, yet dynid raises "the
-    passive joints could not be followed from the assembly without jumping to another assembly
-    mode". Measured on this bar around q (31 x 31 grid, +-0.15 rad): every q whose path stays
-    > 10 mm from the boundary is solved, 11 of 69 with 3-10 mm are refused, 16 of 18 with
-    1-3 mm. The free motion of this bar from q0 + (0.15, -0.1), qd = (0.5, 0.3) (the KKT model)
-    is refused from t = 0.60 s, e.g. q = (-1.19574924, -1.75723273), cond(A_p) = 57 (that
-    motion then reaches the boundary itself at t = 0.667 s and goes on in the other assembly
-    mode, which no closure with a fixed assembly mode can follow; the free-motion test above
-    uses a bar whose motion stays away)."""
+    """q is regular (cond(A_p) = 38) and the straight path from the assembly stays >= 9 mm from
+    the inner workspace boundary (the couplers folded onto each other). dynid d007fa2 refused it
+    ("could not be followed without jumping") after 4 halvings of its continuation steps for the
+    whole batch; from ccc0c68 a jumping sample alone is followed again, up to 64 times finer.
+    On a 31 x 31 grid of +-0.15 rad around q (759 closable configurations) every q whose path
+    stays > 1 mm from the boundary is solved in the assembly's mode (672 of 672; was: 11 of 69
+    refused at 3-10 mm, 16 of 18 at 1-3 mm), 4 of 15 closer are refused, and the 72 whose path
+    crosses the boundary are refused; none is answered in the other mode (see the next test)."""
     bar = _random_five_bar(np.random.default_rng(12), hanging=True)
     q = np.array([-1.22424057, -1.79661435])
     assert _straight_path_gap(bar, q) > 0.009
     _check_assembly_mode(bar, q)
+
+
+def test_five_bar_never_answers_in_the_other_assembly_mode() -> None:
+    """Paths that pass within 0.7 mm of the inner boundary, or cross it: before the check of
+    det(A_p)'s sign along the path (the assembly modes are separated by det(A_p) = 0), dynid
+    tunnelled to the other mode at all of these q with tangents that agreed, and put C 0.52-0.98
+    m from where the assembly's mode has it. Now the paths that cross (negative gap) or pass
+    within 0.07 mm are refused, the others solved in the assembly's mode."""
+    bar = _random_five_bar(np.random.default_rng(12), hanging=True)
+    chain, tree = bar.chain(), bar.tree()
+    refused = [
+        (-1.14424057, -1.88661435),  # the path crosses the boundary (gap -0.15 mm)
+        (-1.13424057, -1.89661435),  # passes 0.07 mm from it
+        (-1.09424057, -1.92661435),  # crosses (-0.55 mm)
+        (-1.08424057, -1.93661435),  # crosses
+        (-1.07424057, -1.94661435),  # crosses
+    ]
+    solved = [
+        (-1.12424057, -1.90661435),  # passes 0.26 mm from it
+        (-1.11424057, -1.91661435),  # 0.47 mm
+        (-1.10424057, -1.92661435),  # 0.65 mm
+    ]
+    for q in refused:
+        assert _straight_path_gap(bar, np.array(q)) < 1e-4
+        with pytest.raises(ValueError, match="cannot be closed along the path"):
+            chain.tree_motion(np.array(q))
+    for q in solved:
+        expected = _closure_points(tree, bar.state(np.array(q)))[0]
+        got = _closure_points(tree, chain.tree_motion(np.array(q)).y[0])[0]
+        assert np.max(np.abs(got - expected)) <= 1e-9, (q, got, expected)

@@ -228,13 +228,17 @@ class PointClosure:
         Newton corrects them. Without the predictor, Newton from the previous step's passive
         joints lands on another branch near a bifurcation (a parallelogram close to folding flat
         jumps to the crossed "anti-parallelogram"); the check catches what the predictor misses:
-        on the same branch dy_p equals the trapezoid rule on the two tangents to O(dq^3)."""
+        on the same branch dy_p equals the trapezoid rule on the two tangents to O(dq^3). Near a
+        fold of the loop (a five-bar's couplers almost folded onto each other) the two assembly
+        modes come close and a step can tunnel to the other one with tangents that agree; the
+        modes are separated by the singular configurations det(A_p) = 0, so a change of the sign
+        of det(A_p) along the path is a jump too (tests/test_closed_chain_pinocchio.py)."""
         start = self.assembly[self.actuated]
         y = np.empty((q.shape[0], self.tree_dof))
         y[:] = self.assembly
         self._newton(branches, y)
         dq = (q - start) / steps
-        tangent = self._tangent(branches, y, dq)
+        tangent, mode = self._tangent(branches, y, dq)
         jumped = np.zeros(q.shape[0], dtype=bool)
         for step in range(steps):
             before = y[:, self.passive].copy()
@@ -242,20 +246,23 @@ class PointClosure:
             y[:, self.passive] += tangent
             self._newton(branches, y, jumped)
             moved = y[:, self.passive] - before
-            tangent_after = self._tangent(branches, y, dq)
+            tangent_after, mode_after = self._tangent(branches, y, dq)
             mismatch = np.abs(moved - 0.5 * (tangent + tangent_after))
             scale = np.maximum(np.abs(moved), np.maximum(np.abs(tangent), np.abs(tangent_after)))
             jumped |= np.any(mismatch > JUMP_FRACTION * scale + 1e-12, axis=1)
+            jumped |= mode_after != mode
             tangent = tangent_after
         return y, jumped
 
     def _tangent(
         self, branches: Sequence[Robot], y: NDArray[np.float64], dq: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """The passive joints' first-order motion -A_p^-1 A_a dq (zero where A_p is singular)."""
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The passive joints' first-order motion -A_p^-1 A_a dq (zero where A_p is singular)
+        and the sign of det(A_p), which tells the assembly modes apart."""
         _, A = self._constraint(branches, y)
-        step = -_solve(A[:, :, self.passive], A[:, :, self.actuated] @ dq[..., None])
-        return np.where(np.isfinite(step[..., 0]), step[..., 0], 0.0)
+        A_p = A[:, :, self.passive]
+        step = -_solve(A_p, A[:, :, self.actuated] @ dq[..., None])
+        return np.where(np.isfinite(step[..., 0]), step[..., 0], 0.0), np.sign(np.linalg.det(A_p))
 
     def _newton(
         self,
