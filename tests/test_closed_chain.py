@@ -554,3 +554,24 @@ def test_point_closure_after_many_turns() -> None:
     np.testing.assert_allclose(far[[0, 2]], turned, rtol=0, atol=0)
     np.testing.assert_allclose(far[[1, 3]], near[[1, 3]], atol=1e-9)
     np.testing.assert_allclose(chain.gravity(turned), chain.gravity(q0), atol=1e-9)
+
+
+def test_the_identification_example(tmp_path, capsys) -> None:
+    """examples/closed_chain_identification.py: a filtered CSV of the motors, positions only;
+    correlation-robust standard deviations that cover the errors (they are 5-7 times the
+    independent-samples ones, which left Fv1, Fs1 5-6 of them off)."""
+    import importlib.util
+    import re
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "closed_chain_identification.py"
+    spec = importlib.util.spec_from_file_location("closed_chain_example", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.main(tmp_path)
+    out = capsys.readouterr().out
+    assert "the residuals are correlated in time" in out
+    error, z = re.search(r"largest error: ([\d.]+)% .*largest \|z\| ([\d.]+)", out).groups()
+    assert float(error) < 1.0
+    assert float(z) < 3.0
+    assert (tmp_path / "parallelogram_motors.csv").is_file()

@@ -9,6 +9,7 @@ records them: q, tau (and qd, qdd when it has them) of the n motors. The log goe
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,8 +21,9 @@ from ..logs.log_files import Log
 from ..logs.preparation import prepare_log
 from ..model.base_parameters import BaseParameters
 from ..model.closed_chain import ClosedChain
-from .identify import LeastSquaresResult, least_squares
+from .identify import VARIANCE_FLOOR, LeastSquaresResult, least_squares, relative_std
 from .log_identification import _with_derivatives
+from .serial_correlation import correlation_robust_covariance
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,11 +91,40 @@ def identify_closed_chain(
         friction=friction,
         columns=base.independent,
     )
+    Y = Y.reshape(-1, chain.n, base.count)
     fit = least_squares(
-        Y.reshape(-1, chain.n, base.count),
-        prepared.tau,
-        method=method,
-        names=base.names,
-        on_rank_deficient=on_rank_deficient,
+        Y, prepared.tau, method=method, names=base.names, on_rank_deficient=on_rank_deficient
     )
-    return ClosedChainIdentification(base=base, fit=fit, notes=list(prepared.notes))
+    notes = list(prepared.notes)
+    fit, note = _correlation_robust(fit, Y, prepared.tau)
+    return ClosedChainIdentification(base=base, fit=fit, notes=notes + note)
+
+
+def _correlation_robust(
+    fit: LeastSquaresResult, Y: NDArray[np.float64], tau: NDArray[np.float64]
+) -> tuple[LeastSquaresResult, list[str]]:
+    """The fit with the correlation-robust covariance when its residuals are correlated in time
+    (a filtered log: :mod:`dynid.identification.serial_correlation`, as ``identify_log``)."""
+    if fit.rank < fit.theta.size or not np.all(np.isfinite(fit.covariance)):
+        return fit, []
+    weights = np.ones(tau.shape[1])
+    if fit.method == "wls":
+        variance = np.asarray(fit.noise_variance, dtype=float)
+        largest = variance.max()
+        weights = 1.0 / np.maximum(variance, VARIANCE_FLOOR * largest) if largest > 0 else weights
+    robust = correlation_robust_covariance(Y, tau - Y @ fit.theta, weights)
+    if robust is None:
+        return fit, []
+    covariance, correlation_time, width = robust
+    std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    ratio = std / np.where(fit.std > 0, fit.std, np.inf)
+    note = (
+        f"the residuals are correlated in time (integrated correlation time "
+        f"{correlation_time:.3g} samples, e.g. a filtered log or a model error): standard "
+        f"deviations from that correlation (Newey-West, Bartlett width {width}), "
+        f"{np.nanmin(ratio):.2g}-{np.nanmax(ratio):.2g} times the independent-samples ones"
+    )
+    robust_fit = dataclasses.replace(
+        fit, covariance=covariance, std=std, relative_std=relative_std(fit.theta, std)
+    )
+    return robust_fit, [note]

@@ -61,6 +61,7 @@ from .identify import VARIANCE_FLOOR, LeastSquaresResult, relative_std
 from .physical import physical_least_squares
 from .separable import estimate_nonlinear
 from .serial_correlation import (
+    WHITE_CORRELATION_TIME,
     WIDTH_PER_WINDOW,
     LongRunAccumulator,
     autocorrelation,
@@ -79,11 +80,6 @@ DEFAULT_PRIOR_WEIGHT = 1e-5
 
 #: Samples per regressor chunk folded into the least-squares factors.
 STREAM_CHUNK = 8192
-#: Residuals whose integrated autocorrelation time (in samples, 1 for independent ones) is below
-#: this keep the independent-samples standard deviations; above it the correlation-robust ones
-#: replace them (_correlation_robust_std). White noise gives 1 +- a few hundredths.
-WHITE_CORRELATION_TIME = 1.5
-
 #: Largest training regressor (bytes) that :func:`identify_log` keeps between the least-squares
 #: pass and the prediction of the training log, so that the log's regressor is computed once;
 #: a longer log's regressor is computed again chunk by chunk (memory bounded by a chunk).

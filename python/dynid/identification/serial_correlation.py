@@ -35,6 +35,10 @@ SOKAL_C = 5.0
 WIDTH_PER_WINDOW = 2
 #: At most this fraction of the shortest segment (the kernel's bias grows with L / T).
 MAX_WIDTH_FRACTION = 0.1
+#: Residuals whose integrated autocorrelation time (in samples, 1 for independent ones) is below
+#: this keep the independent-samples standard deviations; above it the correlation-robust ones
+#: replace them. White noise gives 1 +- a few hundredths.
+WHITE_CORRELATION_TIME = 1.5
 
 
 def autocorrelation(residuals: Sequence[NDArray[np.float64]], lags: int) -> NDArray[np.float64]:
@@ -91,6 +95,28 @@ def long_run_covariance(
         batches = cumulative[L:] - cumulative[:-L]  # (T - L + 1, q) sums of L consecutive h_t
         omega += batches.T @ batches / L * _batch_scale(T, L)
     return omega
+
+
+def correlation_robust_covariance(
+    Y: NDArray[np.float64], residuals: NDArray[np.float64], weights: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], float, int] | None:
+    """The sandwich A^-1 Omega A^-1 of a least-squares fit held in memory: Y (T, n, p) the
+    regressor, residuals (T, n) tau - Y theta, weights (n,) the fit's row weights (1 for OLS,
+    1 / sigma_j^2 for WLS). With the integrated correlation time and the Bartlett width; None
+    when the residuals are independent (correlation time below WHITE_CORRELATION_TIME), so that
+    the least-squares covariance stands. (``identify_log`` does the same chunk by chunk.)"""
+    weighted = residuals * np.sqrt(weights)
+    window = correlation_window([weighted])
+    correlation_time = 1.0 + 2.0 * float(autocorrelation([weighted], window)[1:].sum())
+    if correlation_time < WHITE_CORRELATION_TIME:
+        return None
+    width = WIDTH_PER_WINDOW * window
+    WY = Y * weights[None, :, None]
+    A = np.einsum("tjp,tjq->pq", WY, Y)
+    scale = 1.0 / np.sqrt(np.where(np.diag(A) > 0, np.diag(A), 1.0))
+    inverse = scale[:, None] * np.linalg.pinv(A * scale[:, None] * scale[None, :]) * scale[None, :]
+    influence = np.einsum("tjp,tj->tp", WY, residuals) @ inverse.T
+    return long_run_covariance([influence], width), correlation_time, width
 
 
 class LongRunAccumulator:
