@@ -23,7 +23,7 @@ from ..model.base_parameters import BaseParameters
 from ..model.closed_chain import ClosedChain
 from .identify import VARIANCE_FLOOR, LeastSquaresResult, least_squares, relative_std
 from .log_identification import _with_derivatives
-from .serial_correlation import correlation_robust_covariance
+from .serial_correlation import correlation_note, correlation_robust_covariance
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,12 +118,7 @@ def _correlation_robust(
     covariance, correlation_time, width = robust
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     ratio = std / np.where(fit.std > 0, fit.std, np.inf)
-    note = (
-        f"the residuals are correlated in time (integrated correlation time "
-        f"{correlation_time:.3g} samples, e.g. a filtered log or a model error): standard "
-        f"deviations from that correlation (Newey-West, Bartlett width {width}), "
-        f"{np.nanmin(ratio):.2g}-{np.nanmax(ratio):.2g} times the independent-samples ones"
-    )
+    note = correlation_note(correlation_time, width, ratio)
     robust_fit = dataclasses.replace(
         fit, covariance=covariance, std=std, relative_std=relative_std(fit.theta, std)
     )

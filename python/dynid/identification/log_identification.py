@@ -65,7 +65,9 @@ from .serial_correlation import (
     WIDTH_PER_WINDOW,
     LongRunAccumulator,
     autocorrelation,
+    correlation_note,
     correlation_window,
+    scaled_inverse,
 )
 from .streaming import LeastSquaresAccumulator
 from .validation import error_metrics, validation_table
@@ -691,8 +693,7 @@ def _correlation_robust_std(
     for r, c, cached in chunks:
         Y, WY = weighted(r, c, cached)
         A += np.einsum("tjp,tjq->pq", WY, Y)
-    scale = 1.0 / np.sqrt(np.where(np.diag(A) > 0, np.diag(A), 1.0))
-    inverse = scale[:, None] * np.linalg.pinv(A * scale[:, None] * scale[None, :]) * scale[None, :]
+    inverse = scaled_inverse(A)
     accumulator = LongRunAccumulator(p, width)
     current = 0
     for r, c, cached in chunks:
@@ -711,12 +712,7 @@ def _correlation_robust_std(
     ratio = std / np.where(result.std > 0, result.std, np.inf)
     result.covariance, result.std = robust, std
     result.relative_std = relative_std(result.theta, std)
-    return [
-        f"the residuals are correlated in time (integrated correlation time "
-        f"{correlation_time:.3g} samples, e.g. a filtered log or a model error): standard "
-        f"deviations from that correlation (Newey-West, Bartlett width {width}), "
-        f"{np.nanmin(ratio):.2g}-{np.nanmax(ratio):.2g} times the independent-samples ones"
-    ]
+    return [correlation_note(correlation_time, width, ratio)]
 
 
 def _estimator_options(method: str, options: Mapping[str, Any] | None) -> dict[str, Any]:

@@ -112,11 +112,30 @@ def correlation_robust_covariance(
         return None
     width = WIDTH_PER_WINDOW * window
     WY = Y * weights[None, :, None]
-    A = np.einsum("tjp,tjq->pq", WY, Y)
-    scale = 1.0 / np.sqrt(np.where(np.diag(A) > 0, np.diag(A), 1.0))
-    inverse = scale[:, None] * np.linalg.pinv(A * scale[:, None] * scale[None, :]) * scale[None, :]
+    inverse = scaled_inverse(np.einsum("tjp,tjq->pq", WY, Y))
     influence = np.einsum("tjp,tj->tp", WY, residuals) @ inverse.T
     return long_run_covariance([influence], width), correlation_time, width
+
+
+def scaled_inverse(A: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A^-1 of the normal matrix A = sum Y^T W Y, computed on its unit-diagonal scaling (columns
+    of very different units keep their precision); a pseudo-inverse for a singular A."""
+    scale = 1.0 / np.sqrt(np.where(np.diag(A) > 0, np.diag(A), 1.0))
+    inverse: NDArray[np.float64] = (
+        scale[:, None] * np.linalg.pinv(A * scale[:, None] * scale[None, :]) * scale[None, :]
+    )
+    return inverse
+
+
+def correlation_note(correlation_time: float, width: int, ratio: NDArray[np.float64]) -> str:
+    """What a result's notes say when its standard deviations are the correlation-robust ones:
+    ``ratio`` is robust / independent-samples std, parameter by parameter."""
+    return (
+        f"the residuals are correlated in time (integrated correlation time "
+        f"{correlation_time:.3g} samples, e.g. a filtered log or a model error): standard "
+        f"deviations from that correlation (Newey-West, Bartlett width {width}), "
+        f"{np.nanmin(ratio):.2g}-{np.nanmax(ratio):.2g} times the independent-samples ones"
+    )
 
 
 class LongRunAccumulator:
