@@ -16,9 +16,30 @@ constexpr int W = DYNID_LANES;
 typedef double V __attribute__((vector_size(8 * W)));
 typedef long long Bits __attribute__((vector_size(8 * W)));
 
+// x in every lane: one broadcast (an addition to a zero vector would cost one more instruction
+// per constant, and the lane kernels splat a model constant at almost every step).
 inline V splat(double x) {
-  V v = {};
-  return v + x;
+  V v;
+  for (int l = 0; l < W; ++l) v[l] = x;
+  return v;
+}
+
+// True when any lane of the mask is set: the lanes OR-ed pairwise by shuffles (log2 W steps), so
+// that a test of all lanes costs one branch instead of one per lane.
+inline bool any_lane(Bits m) {
+#if DYNID_LANES == 8
+  m |= __builtin_shuffle(m, Bits{4, 5, 6, 7, 0, 1, 2, 3});
+  m |= __builtin_shuffle(m, Bits{2, 3, 0, 1, 6, 7, 4, 5});
+  m |= __builtin_shuffle(m, Bits{1, 0, 3, 2, 5, 4, 7, 6});
+#elif DYNID_LANES == 4
+  m |= __builtin_shuffle(m, Bits{2, 3, 0, 1});
+  m |= __builtin_shuffle(m, Bits{1, 0, 3, 2});
+#elif DYNID_LANES == 2
+  m |= __builtin_shuffle(m, Bits{1, 0});
+#else
+#error "DYNID_LANES: 2, 4 or 8"
+#endif
+  return m[0] != 0;
 }
 
 // ------------------------------------------------------------------------ sin and cos per lane
@@ -34,7 +55,10 @@ constexpr double kRoundMagic = 0x1.8p52;  // (x + 1.5 2^52) - 1.5 2^52 rounds to
 constexpr double kReductionLimit = 1e6;
 
 inline void sincos_lanes(V x, V& s, V& c) {
-  const V k = (x * kTwoOverPi + kRoundMagic) - kRoundMagic;
+  // shifted = 1.5 2^52 + k exactly, so its low mantissa bits are k mod 2^51: the quadrant without
+  // a conversion to integers (which AVX2 does not have for doubles: one scalar per lane).
+  const V shifted = x * kTwoOverPi + kRoundMagic;
+  const V k = shifted - kRoundMagic;
   V r = x - k * kPiOver2Part1;
   r = r - k * kPiOver2Part2;
   r = r - k * kPiOver2Part3;
@@ -58,7 +82,7 @@ inline void sincos_lanes(V x, V& s, V& c) {
   const V sr = r + r * z * ps;
   const V cr = (1.0 - 0.5 * z) + z * z * pc;
   // Quadrant k mod 4: sin = (s, c, -s, -c), cos = (c, -s, -c, s).
-  const Bits quadrant = __builtin_convertvector(k, Bits);
+  const Bits quadrant = (Bits)shifted;
   const Bits swap = -(quadrant & 1);  // all ones where k is odd
   const Bits sb = (Bits)sr, cb = (Bits)cr;
   Bits sin_bits = (swap & cb) | (~swap & sb);
@@ -67,10 +91,13 @@ inline void sincos_lanes(V x, V& s, V& c) {
   cos_bits ^= ((quadrant + 1) & 2) << 62;
   s = (V)sin_bits;
   c = (V)cos_bits;
-  for (int l = 0; l < W; ++l) {
-    if (!(x[l] <= kReductionLimit && x[l] >= -kReductionLimit)) {
-      s[l] = __builtin_sin(x[l]);
-      c[l] = __builtin_cos(x[l]);
+  const Bits inside = (x <= kReductionLimit) & (x >= -kReductionLimit);  // false for NaN
+  if (any_lane(~inside)) {
+    for (int l = 0; l < W; ++l) {
+      if (!inside[l]) {
+        s[l] = __builtin_sin(x[l]);
+        c[l] = __builtin_cos(x[l]);
+      }
     }
   }
 }
@@ -171,7 +198,12 @@ inline long store(const V* values, int width, double* out, long t0, int count) {
   return -1;
 }
 
-inline V sign(const V& x) { return __builtin_convertvector((Bits)(x < 0.0) - (Bits)(x > 0.0), V); }
+// sign(x) per lane, 0 for 0 and NaN (drive_terms.hpp): the bits of +1 and -1 selected by the
+// comparisons' masks (no integer to double conversion, which AVX2 lacks).
+inline V sign(const V& x) {
+  const Bits plus = (Bits)splat(1.0), minus = (Bits)splat(-1.0);
+  return (V)(((Bits)(x > 0.0) & plus) | ((Bits)(x < 0.0) & minus));
+}
 
 // ------------------------------------------------------------------------------- the kernels
 // Backward pass of accumulate_wrenches (rnea.cpp): link i's wrench added to its parent's, and
