@@ -8,39 +8,10 @@
 // here includes a library header (see batch_model.hpp: no inline function may be shared with the
 // baseline code), and everything has internal linkage.
 #include "dynid/detail/batch_model.hpp"
+#include "lane_vectors.hpp"
 
 namespace dynid::detail::DYNID_LANES_NS {
 namespace {
-
-constexpr int W = DYNID_LANES;
-typedef double V __attribute__((vector_size(8 * W)));
-typedef long long Bits __attribute__((vector_size(8 * W)));
-
-// x in every lane: one broadcast (an addition to a zero vector would cost one more instruction
-// per constant, and the lane kernels splat a model constant at almost every step).
-inline V splat(double x) {
-  V v;
-  for (int l = 0; l < W; ++l) v[l] = x;
-  return v;
-}
-
-// True when any lane of the mask is set: the lanes OR-ed pairwise by shuffles (log2 W steps), so
-// that a test of all lanes costs one branch instead of one per lane.
-inline bool any_lane(Bits m) {
-#if DYNID_LANES == 8
-  m |= __builtin_shuffle(m, Bits{4, 5, 6, 7, 0, 1, 2, 3});
-  m |= __builtin_shuffle(m, Bits{2, 3, 0, 1, 6, 7, 4, 5});
-  m |= __builtin_shuffle(m, Bits{1, 0, 3, 2, 5, 4, 7, 6});
-#elif DYNID_LANES == 4
-  m |= __builtin_shuffle(m, Bits{2, 3, 0, 1});
-  m |= __builtin_shuffle(m, Bits{1, 0, 3, 2});
-#elif DYNID_LANES == 2
-  m |= __builtin_shuffle(m, Bits{1, 0});
-#else
-#error "DYNID_LANES: 2, 4 or 8"
-#endif
-  return m[0] != 0;
-}
 
 // ------------------------------------------------------------------------ sin and cos per lane
 // Cody-Waite reduction x = k pi/2 + r, |r| <= pi/4, with pi/2 split into two 33-bit parts and a
@@ -169,35 +140,6 @@ inline V3 rotate_to_parent(const Joint& X, const V3& v) {
   return {y0, X.ca * y1 - X.sa * v.z, X.sa * y1 + X.ca * v.z};
 }
 
-// ------------------------------------------------------------------ loading and storing lanes
-// Sample t0 + l of column `column` of a row-major (T, width) array into lane l; lanes past the
-// last sample hold zeros (evaluated, never stored).
-inline V load(const double* data, long t0, int count, int width, int column) {
-  V v = {};
-  const double* p = data + t0 * width + column;
-  if (count == W) {
-    for (int l = 0; l < W; ++l) v[l] = p[l * width];
-  } else {
-    for (int l = 0; l < count; ++l) v[l] = p[l * width];
-  }
-  return v;
-}
-
-// Stores `values` (one vector per output entry) for the samples of the block and returns the
-// first sample with a non-finite entry, or -1. x * 0 is NaN exactly when x is not finite.
-inline long store(const V* values, int width, double* out, long t0, int count) {
-  V check = {};
-  double* p = out + t0 * width;
-  for (int k = 0; k < width; ++k) {
-    const V v = values[k];
-    check += v * 0.0;
-    for (int l = 0; l < count; ++l) p[l * width + k] = v[l];
-  }
-  for (int l = 0; l < count; ++l)
-    if (check[l] != 0.0) return t0 + l;
-  return -1;
-}
-
 // sign(x) per lane, 0 for 0 and NaN (drive_terms.hpp): the bits of +1 and -1 selected by the
 // comparisons' masks (no integer to double conversion, which AVX2 lacks).
 inline V sign(const V& x) {
@@ -224,15 +166,17 @@ long rnea(const BatchModel& bm, const double* q, const double* qd, const double*
   const int n = bm.n;
   Joint X[n + 1];
   V3 f[n + 1], mu[n + 1];
-  V out[n], drive[n];
+  V out[n], drive[n], qv[n], qdv[n], qddv[n];
   for (long t0 = 0; t0 < T; t0 += W) {
     const int count = T - t0 < W ? static_cast<int>(T - t0) : W;
+    load_block(q, t0, count, n, qv);
+    load_block(qd, t0, count, n, qdv);
+    load_block(qdd, t0, count, n, qddv);
     const V zero = {};
     V3 w = {zero, zero, zero}, wd = w, a = splat3(bm.base_acceleration);
     for (int i = 1; i <= n; ++i) {  // forward pass (propagate_motion) and link wrenches
       const BatchJoint& J = bm.joints[i - 1];
-      const V qi = load(q, t0, count, n, i - 1), qdi = load(qd, t0, count, n, i - 1),
-              qddi = load(qdd, t0, count, n, i - 1);
+      const V qi = qv[i - 1], qdi = qdv[i - 1], qddi = qddv[i - 1];
       set_joint(J, qi, X[i]);
       const V3& p = X[i].p;
       const V3 origin_acc = a + cross(wd, p) + cross(w, cross(w, p));
@@ -265,13 +209,14 @@ long gravity(const BatchModel& bm, const double* q, double* g, long T) {
   const int n = bm.n;
   Joint X[n + 1];
   V3 f[n + 1], mu[n + 1];
-  V out[n];
+  V out[n], qv[n];
   for (long t0 = 0; t0 < T; t0 += W) {
     const int count = T - t0 < W ? static_cast<int>(T - t0) : W;
+    load_block(q, t0, count, n, qv);
     V3 a = splat3(bm.base_acceleration);
     for (int i = 1; i <= n; ++i) {
       const BatchJoint& J = bm.joints[i - 1];
-      set_joint(J, load(q, t0, count, n, i - 1), X[i]);
+      set_joint(J, qv[i - 1], X[i]);
       a = rotate_to_child(X[i], a);
       f[i] = splat(J.m) * a;
       mu[i] = cross(splat3(J.h), a);
@@ -327,12 +272,13 @@ long mass_matrix(const BatchModel& bm, const double* q, double* M, long T) {
   const int n = bm.n;
   Joint X[n + 1];
   Composite C[n + 1];
-  V B[n * n];
+  V B[n * n], qv[n];
   for (long t0 = 0; t0 < T; t0 += W) {
     const int count = T - t0 < W ? static_cast<int>(T - t0) : W;
+    load_block(q, t0, count, n, qv);
     for (int i = 1; i <= n; ++i) {
       const BatchJoint& J = bm.joints[i - 1];
-      set_joint(J, load(q, t0, count, n, i - 1), X[i]);
+      set_joint(J, qv[i - 1], X[i]);
       C[i].m = splat(J.m);
       C[i].h = splat3(J.h);
       for (int e = 0; e < 6; ++e) C[i].I[e] = splat(J.I[e]);
