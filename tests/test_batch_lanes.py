@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import dynid
-from conftest import ARM_CASES, make_arm, random_state
+from conftest import ARM_CASES, make_arm, random_arm, random_state
 from dynid import _core
 
 LANE_PATHS = [isa for isa in _core._supported_batch_isas() if isa != "scalar"]
@@ -83,6 +83,25 @@ def test_lanes_equal_single_calls_for_every_batch_size(
             lambda *x: robot.regressor(*x, rotor=True, friction=True)[:, columns], q, qd, qdd
         ),
     )
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 8, 9, 13, 16])
+def test_lanes_on_chains_of_every_width(lane_path: str, n: int) -> None:
+    # Whole blocks move their rows by groups of 4 (2) columns with in-register transposes, the
+    # last group shifted back to overlap the one before; chains narrower than a group keep
+    # the lane-by-lane moves. Widths around and across the group size, 8 and 16 samples
+    # (whole blocks of every lane count) and 19 (a partial one), against the single calls.
+    arm = random_arm(np.random.default_rng(100 + n), n)
+    robot = arm.robot()
+    for count in (8, 16, 19):
+        q, qd, qdd = states(arm, count, seed=n * count)
+        assert_same(robot.rnea(q, qd, qdd), per_sample(robot.rnea, q, qd, qdd))
+        assert_same(robot.gravity(q), per_sample(robot.gravity, q))
+        assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
+        assert_same(
+            robot.regressor(q, qd, qdd, rotor=True, friction=True),
+            per_sample(lambda *x: robot.regressor(*x, rotor=True, friction=True), q, qd, qdd),
+        )
 
 
 @pytest.mark.parametrize("q_scale", [1e3, 1e4, 1e5, 3e6])
