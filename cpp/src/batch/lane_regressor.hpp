@@ -96,15 +96,19 @@ inline long store_regressor(const V* values, int n, int P, int rotor, int fricti
     double* first = base + i * P;  // row i of the block's first sample
     for (int l = 0; l < count; ++l) {
       double* r = first + l * stride;
-      __builtin_memset(r, 0, sizeof(double) * 10 * i);
-      if (P > drive) __builtin_memset(r + drive, 0, sizeof(double) * (P - drive));
+      zero_fill(r, 10 * i);
+      zero_fill(r + drive, P - drive);
     }
-    for (int k = 10 * i; k < drive; ++k) add_check(check, row[k]);
     if (count == W) {  // 10 (n - i) >= 10 >= G columns
-      by_groups(10 * i, drive, [&](int k) { store_group(row + k, first + k, stride); });
+      by_groups(10 * i, drive, [&](int k) {
+        for (int g = 0; g < G; ++g) add_check(check, row[k + g]);
+        store_group(row + k, first + k, stride);
+      });
     } else {
-      for (int k = 10 * i; k < drive; ++k)
+      for (int k = 10 * i; k < drive; ++k) {
+        add_check(check, row[k]);
         for (int l = 0; l < count; ++l) first[l * stride + k] = row[k][l];
+      }
     }
     int diagonal[3], entries = 0, column = drive;  // row i's own Ia, Fv, Fs columns
     if (rotor) diagonal[entries++] = column + i, column += n;
@@ -127,13 +131,15 @@ long regressor(const BatchModel& bm, const double* q, const double* qd, const do
   V d[n + 1];     // joint offsets along z (prismatic: q + d)
   V U[n + 1][6];  // joint axes in the current link's parameter frame
   V out[n * P], qv[n], qdv[n], qddv[n];
+  const V zero = {};
+  // Every block writes the same entries of `out` (blocks Y_ij, i <= j, and the drive diagonals):
+  // the structural zeros, which store_columns may read, are set once.
+  for (int k = 0; k < n * P; ++k) out[k] = zero;
   for (long t0 = 0; t0 < T; t0 += W) {
     const int count = T - t0 < W ? static_cast<int>(T - t0) : W;
     load_block(q, t0, count, n, qv);
     load_block(qd, t0, count, n, qdv);
     load_block(qdd, t0, count, n, qddv);
-    const V zero = {};
-    for (int k = 0; k < n * P; ++k) out[k] = zero;
     V3 w = {zero, zero, zero}, wd = w, a = splat3(bm.base_acceleration);
     for (int j = 1; j <= n; ++j) {
       const BatchJoint& J = bm.joints[j - 1];

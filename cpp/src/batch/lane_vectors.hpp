@@ -136,7 +136,18 @@ inline void store_group(const V* cols, double* p, long stride) {
 // G does not divide the count: those entries are moved twice, with the same values).
 template <class Move>
 inline void by_groups(int begin, int end, Move move) {
-  for (int c0 = begin; c0 < end; c0 += G) move(c0 + G <= end ? c0 : end - G);
+  for (int c0 = begin; c0 + G < end; c0 += G) move(c0);
+  move(end - G);
+}
+
+// p[0 .. count) = 0 by stores of G doubles (a memset call per short run costs more).
+inline void zero_fill(double* p, int count) {
+  if (count < G) {
+    for (int k = 0; k < count; ++k) p[k] = 0.0;
+    return;
+  }
+  const V zero = {};
+  by_groups(0, count, [&](int k) { __builtin_memcpy(p + k, &zero, sizeof(double) * G); });
 }
 
 // ------------------------------------------------------------------ loading and storing lanes
