@@ -168,6 +168,24 @@ def test_lanes_report_overflow_by_name(lane_path: str) -> None:
         robot.mass_matrix(q)
 
 
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_large_inputs_with_nan_or_inf_are_named(value: float) -> None:
+    # Inputs of 64 values and more are checked by the SIMD lanes (16 values a step on AVX2, 32
+    # on AVX-512, a scalar tail): a bad value anywhere, first, inside the vector steps or in the
+    # tail, is a ValueError naming the input and the element; huge finite values are not.
+    arm = make_arm("lwr")
+    robot = arm.robot()
+    q, qd, qdd = states(arm, 101, seed=9)  # 707 values: 44 steps of 16, 22 of 32, and a tail
+    q[50, 3] = 1e308  # finite (an angle libm reduces): no error
+    assert np.isfinite(robot.rnea(q, qd, qdd)).all()
+    for index, name in enumerate(("q", "qd", "qdd")):
+        for element in (0, 17, 350, 703, 706):
+            bad = [q.copy(), qd.copy(), qdd.copy()]
+            bad[index].flat[element] = value
+            with pytest.raises(ValueError, match=rf"^{name}: contains NaN or inf \(element {element}\)"):
+                robot.rnea(*bad)
+
+
 def test_vectorised_sincos_within_a_few_ulp_of_libm() -> None:
     # The sin/cos of every joint transform (single calls and lanes) against NumPy's (libm,
     # < 1 ulp): 4 ulp of the value (relative, also next to the zeros of sin and cos), for
