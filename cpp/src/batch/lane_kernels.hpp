@@ -184,17 +184,15 @@ long rnea(const BatchModel& bm, const double* q, const double* qd, const double*
   const int n = bm.n;
   Joint X[n + 1];
   V3 f[n + 1], mu[n + 1];
-  V out[n], drive[n], qv[n], qdv[n], qddv[n];
+  V out[n], drive[n];
   for (long t0 = 0; t0 < T; t0 += W) {
     const int count = T - t0 < W ? static_cast<int>(T - t0) : W;
-    load_block(q, t0, count, n, qv);
-    load_block(qd, t0, count, n, qdv);
-    load_block(qdd, t0, count, n, qddv);
     const V zero = {};
     V3 w = {zero, zero, zero}, wd = w, a = splat3(bm.base_acceleration);
     for (int i = 1; i <= n; ++i) {  // forward pass (propagate_motion) and link wrenches
       const BatchJoint& J = bm.joints[i - 1];
-      const V qi = qv[i - 1], qdi = qdv[i - 1], qddi = qddv[i - 1];
+      const V qi = load_column(q, t0, count, n, i - 1), qdi = load_column(qd, t0, count, n, i - 1),
+              qddi = load_column(qdd, t0, count, n, i - 1);
       set_joint(J, qi, X[i]);
       const V3& p = X[i].p;
       const V3 origin_acc = a + cross(wd, p) + cross(w, cross(w, p));

@@ -99,7 +99,7 @@ inline long store_regressor(const V* values, int n, int P, int rotor, int fricti
       zero_fill(r, 10 * i);
       zero_fill(r + drive, P - drive);
     }
-    if (count == W) {  // 10 (n - i) >= 10 >= G columns
+    if (kByGroups && count == W) {  // 10 (n - i) >= 10 >= G columns
       by_groups(10 * i, drive, [&](int k) {
         for (int g = 0; g < G; ++g) add_check(check, row[k + g]);
         store_group(row + k, first + k, stride);
