@@ -190,13 +190,16 @@ inline long first_nonfinite(const V& check, long t0, int count) {
 // first sample with a non-finite entry, or -1.
 inline long store(const V* values, int width, double* out, long t0, int count) {
   V check = {};
-  for (int k = 0; k < width; ++k) add_check(check, values[k]);
   double* p = out + t0 * width;
   if (kByGroups && count == W && width >= G) {
+    for (int k = 0; k < width; ++k) add_check(check, values[k]);
     by_groups(0, width, [&](int c) { store_group(values + c, p + c, width); });
   } else {
-    for (int k = 0; k < width; ++k)
-      for (int l = 0; l < count; ++l) p[l * width + k] = values[k][l];
+    for (int k = 0; k < width; ++k) {
+      const V v = values[k];
+      add_check(check, v);
+      for (int l = 0; l < count; ++l) p[l * width + k] = v[l];
+    }
   }
   return first_nonfinite(check, t0, count);
 }
