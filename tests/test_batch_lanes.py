@@ -182,7 +182,9 @@ def test_large_inputs_with_nan_or_inf_are_named(value: float) -> None:
         for element in (0, 17, 350, 703, 706):
             bad = [q.copy(), qd.copy(), qdd.copy()]
             bad[index].flat[element] = value
-            with pytest.raises(ValueError, match=rf"^{name}: contains NaN or inf \(element {element}\)"):
+            with pytest.raises(
+                ValueError, match=rf"^{name}: contains NaN or inf \(element {element}\)"
+            ):
                 robot.rnea(*bad)
 
 

@@ -14,5 +14,5 @@ const LaneKernels lanes_sse2 = {"sse2",
                                 &lanes_sse2_impl::mass_matrix,
                                 &lanes_sse2_impl::regressor,
                                 &lanes_sse2_impl::sincos_many,
- &lanes_sse2_impl::all_finite};
+                                &lanes_sse2_impl::all_finite};
 }  // namespace dynid::detail

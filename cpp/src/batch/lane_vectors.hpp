@@ -107,11 +107,11 @@ inline V4 low(const V& v) { return V4{v[0], v[1], v[2], v[3]}; }
 inline V4 high(const V& v) { return V4{v[4], v[5], v[6], v[7]}; }
 inline void load_group(const double* p, long stride, V* cols) {
   V4 a0, a1, a2, a3, b0, b1, b2, b3;
-  transpose4(load4(p), load4(p + stride), load4(p + 2 * stride), load4(p + 3 * stride), a0, a1,
-             a2, a3);
+  transpose4(load4(p), load4(p + stride), load4(p + 2 * stride), load4(p + 3 * stride), a0, a1, a2,
+             a3);
   const double* q = p + 4 * stride;
-  transpose4(load4(q), load4(q + stride), load4(q + 2 * stride), load4(q + 3 * stride), b0, b1,
-             b2, b3);
+  transpose4(load4(q), load4(q + stride), load4(q + 2 * stride), load4(q + 3 * stride), b0, b1, b2,
+             b3);
   cols[0] = join(a0, b0), cols[1] = join(a1, b1), cols[2] = join(a2, b2), cols[3] = join(a3, b3);
 }
 inline void store_group(const V* cols, double* p, long stride) {

@@ -13,5 +13,5 @@ const LaneKernels lanes_avx2 = {"avx2",
                                 &lanes_avx2_impl::mass_matrix,
                                 &lanes_avx2_impl::regressor,
                                 &lanes_avx2_impl::sincos_many,
- &lanes_avx2_impl::all_finite};
+                                &lanes_avx2_impl::all_finite};
 }  // namespace dynid::detail
