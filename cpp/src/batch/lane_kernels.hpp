@@ -158,6 +158,18 @@ inline V3 rotate_to_parent(const Joint& X, const V3& v) {
   return {y0, X.ca * y1 - X.sa * v.z, X.sa * y1 + X.ca * v.z};
 }
 
+// True when the origin of link i's frame is that of J_{i-1} (revolute, a = d = 0: X.p = 0), as
+// for 5 of the LWR-IV's 7 joints: the terms in p, exact zeros then, are skipped (x + 0 is x, so
+// no finite result changes; 0 * inf is NaN, but an overflow is reported from the other terms).
+inline bool at_parent_origin(const BatchJoint& j) { return j.revolute && j.a == 0.0 && j.d == 0.0; }
+
+// The acceleration of the origin of J_i, a + wd x p + w x (w x p) (propagate_motion), in J_{i-1}.
+inline V3 origin_acceleration(const BatchJoint& j, const Joint& X, const V3& w, const V3& wd,
+                              const V3& a) {
+  if (at_parent_origin(j)) return a;
+  return a + cross(wd, X.p) + cross(w, cross(w, X.p));
+}
+
 // sign(x) per lane, 0 for 0 and NaN (drive_terms.hpp): the bits of +1 and -1 selected by the
 // comparisons' masks (no integer to double conversion, which AVX2 lacks).
 inline V sign(const V& x) {
@@ -174,7 +186,8 @@ inline void accumulate(const BatchModel& bm, const Joint* X, V3* f, V3* mu, V* o
     if (i > 1) {
       const V3 f_parent = rotate_to_parent(X[i], f[i]);
       f[i - 1] += f_parent;
-      mu[i - 1] += rotate_to_parent(X[i], mu[i]) + cross(X[i].p, f_parent);
+      mu[i - 1] += rotate_to_parent(X[i], mu[i]);
+      if (!at_parent_origin(bm.joints[i - 1])) mu[i - 1] += cross(X[i].p, f_parent);
     }
   }
 }
@@ -194,8 +207,7 @@ long rnea(const BatchModel& bm, const double* q, const double* qd, const double*
       const V qi = load_column(q, t0, count, n, i - 1), qdi = load_column(qd, t0, count, n, i - 1),
               qddi = load_column(qdd, t0, count, n, i - 1);
       set_joint(J, qi, X[i]);
-      const V3& p = X[i].p;
-      const V3 origin_acc = a + cross(wd, p) + cross(w, cross(w, p));
+      const V3 origin_acc = origin_acceleration(J, X[i], w, wd, a);
       const V3 w_in = rotate_to_child(X[i], w), wd_in = rotate_to_child(X[i], wd);
       const V3 acc = rotate_to_child(X[i], origin_acc);
       if (J.revolute) {

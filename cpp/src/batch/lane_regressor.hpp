@@ -147,8 +147,7 @@ long regressor(const BatchModel& bm, const double* q, const double* qd, const do
       set_joint(J, qj, X[j]);
       d[j] = J.revolute ? splat(J.d) : qj + J.d;
       // Forward pass (propagate_motion): link j's w, wd and origin acceleration in J_j.
-      const V3& p = X[j].p;
-      const V3 origin_acc = a + cross(wd, p) + cross(w, cross(w, p));
+      const V3 origin_acc = origin_acceleration(J, X[j], w, wd, a);
       const V3 w_in = rotate_to_child(X[j], w), wd_in = rotate_to_child(X[j], wd);
       const V3 acc = rotate_to_child(X[j], origin_acc);
       if (J.revolute) {
