@@ -186,8 +186,9 @@ inline void accumulate(const BatchModel& bm, const Joint* X, V3* f, V3* mu, V* o
     if (i > 1) {
       const V3 f_parent = rotate_to_parent(X[i], f[i]);
       f[i - 1] += f_parent;
-      mu[i - 1] += rotate_to_parent(X[i], mu[i]);
-      if (!at_parent_origin(bm.joints[i - 1])) mu[i - 1] += cross(X[i].p, f_parent);
+      V3 moment = rotate_to_parent(X[i], mu[i]);
+      if (!at_parent_origin(bm.joints[i - 1])) moment += cross(X[i].p, f_parent);
+      mu[i - 1] += moment;
     }
   }
 }
