@@ -316,8 +316,9 @@ inline void add_to_parent(const Joint& X, const Composite& c, Composite& parent)
   for (int e = 0; e < 6; ++e) parent.I[e] += R[e];
 }
 
-long mass_matrix(const BatchModel& bm, const double* q, double* M, long T) {
-  const int n = bm.n;
+template <int N>  // as rnea_of
+long mass_matrix_of(const BatchModel& bm, const double* q, double* M, long T) {
+  const int n = N > 0 ? N : bm.n;
   Joint X[n + 1];
   Composite C[n + 1];
   V B[n * n], qv[n];
@@ -357,6 +358,12 @@ long mass_matrix(const BatchModel& bm, const double* q, double* M, long T) {
     if (bad >= 0) return bad;
   }
   return -1;
+}
+
+long mass_matrix(const BatchModel& bm, const double* q, double* M, long T) {
+  if (bm.n == 7) return mass_matrix_of<7>(bm, q, M, T);
+  if (bm.n == 6) return mass_matrix_of<6>(bm, q, M, T);
+  return mass_matrix_of<0>(bm, q, M, T);
 }
 
 }  // namespace
