@@ -195,7 +195,7 @@ inline void accumulate(const BatchModel& bm, int n, const Joint* X, V3* f, V3* m
 
 // rnea and gravity take the number of joints N as a compile-time constant for the common arms
 // (6 and 7 joints; N = 0: n from the model, any n): the compiler then unrolls the recursions over
-// the links and indexes the per-link arrays statically, measured 15-30 % faster on AVX2 and
+// the links and indexes the per-link arrays statically, measured 10-25 % faster on AVX2 and
 // AVX-512 (the same operations in the same order: the same results).
 template <int N>
 long rnea_of(const BatchModel& bm, const double* q, const double* qd, const double* qdd,
