@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import dynid
-from conftest import ARM_CASES, make_arm, random_state
+from conftest import ARM_CASES, make_arm, random_arm, random_state
 from dynid import _core
 
 LANE_PATHS = [isa for isa in _core._supported_batch_isas() if isa != "scalar"]
@@ -85,6 +85,25 @@ def test_lanes_equal_single_calls_for_every_batch_size(
     )
 
 
+@pytest.mark.parametrize("n", [1, 2, 3, 8, 9, 13, 16])
+def test_lanes_on_chains_of_every_width(lane_path: str, n: int) -> None:
+    # Whole blocks move their rows by groups of 4 (2) columns with in-register transposes, the
+    # last group shifted back to overlap the one before; chains narrower than a group keep
+    # the lane-by-lane moves. Widths around and across the group size, 8 and 16 samples
+    # (whole blocks of every lane count) and 19 (a partial one), against the single calls.
+    arm = random_arm(np.random.default_rng(100 + n), n)
+    robot = arm.robot()
+    for count in (8, 16, 19):
+        q, qd, qdd = states(arm, count, seed=n * count)
+        assert_same(robot.rnea(q, qd, qdd), per_sample(robot.rnea, q, qd, qdd))
+        assert_same(robot.gravity(q), per_sample(robot.gravity, q))
+        assert_same(robot.mass_matrix(q), per_sample(robot.mass_matrix, q))
+        assert_same(
+            robot.regressor(q, qd, qdd, rotor=True, friction=True),
+            per_sample(lambda *x: robot.regressor(*x, rotor=True, friction=True), q, qd, qdd),
+        )
+
+
 @pytest.mark.parametrize("q_scale", [1e3, 1e4, 1e5, 3e6])
 @pytest.mark.parametrize("case", ARM_CASES)
 def test_lanes_large_joint_angles(lane_path: str, case: str, q_scale: float) -> None:
@@ -147,6 +166,26 @@ def test_lanes_report_overflow_by_name(lane_path: str) -> None:
     robot.params = params
     with pytest.raises(ValueError, match="q: the result overflowed"):
         robot.mass_matrix(q)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_large_inputs_with_nan_or_inf_are_named(value: float) -> None:
+    # Inputs of 64 values and more are checked by the SIMD lanes (16 values a step on AVX2, 32
+    # on AVX-512, a scalar tail): a bad value anywhere, first, inside the vector steps or in the
+    # tail, is a ValueError naming the input and the element; huge finite values are not.
+    arm = make_arm("lwr")
+    robot = arm.robot()
+    q, qd, qdd = states(arm, 101, seed=9)  # 707 values: 44 steps of 16, 22 of 32, and a tail
+    q[50, 3] = 1e308  # finite (an angle libm reduces): no error
+    assert np.isfinite(robot.rnea(q, qd, qdd)).all()
+    for index, name in enumerate(("q", "qd", "qdd")):
+        for element in (0, 17, 350, 703, 706):
+            bad = [q.copy(), qd.copy(), qdd.copy()]
+            bad[index].flat[element] = value
+            with pytest.raises(
+                ValueError, match=rf"^{name}: contains NaN or inf \(element {element}\)"
+            ):
+                robot.rnea(*bad)
 
 
 def test_vectorised_sincos_within_a_few_ulp_of_libm() -> None:

@@ -53,17 +53,29 @@ std::atomic<const LaneKernels*>& selected() {
   return choice;
 }
 
-}  // namespace
-
-void sincos_many(const double* x, double* s, double* c, int count) {
-  static const SinCos widest = [] {
+// The widest lanes the CPU runs, whatever path the batches are forced to.
+const LaneKernels* widest_kernels() {
+  static const LaneKernels* const widest = [] {
     const LaneKernels* best = nullptr;
     for (const char* path : kPaths)
       if (cpu_supports(path)) best = kernels_of(path);
-    return best ? best->sincos : nullptr;
+    return best;
   }();
-  if (widest) return widest(x, s, c, count);
+  return widest;
+}
+
+}  // namespace
+
+void sincos_many(const double* x, double* s, double* c, int count) {
+  if (const LaneKernels* lanes = widest_kernels()) return lanes->sincos(x, s, c, count);
   for (int k = 0; k < count; ++k) s[k] = std::sin(x[k]), c[k] = std::cos(x[k]);
+}
+
+bool all_finite_many(const double* x, long count) {
+  if (const LaneKernels* lanes = widest_kernels()) return lanes->all_finite(x, count);
+  for (long k = 0; k < count; ++k)
+    if (!std::isfinite(x[k])) return false;
+  return true;
 }
 
 const LaneKernels* batch_kernels() { return selected().load(std::memory_order_relaxed); }

@@ -13,5 +13,6 @@ const LaneKernels lanes_sse2 = {"sse2",
                                 &lanes_sse2_impl::gravity,
                                 &lanes_sse2_impl::mass_matrix,
                                 &lanes_sse2_impl::regressor,
-                                &lanes_sse2_impl::sincos_many};
+                                &lanes_sse2_impl::sincos_many,
+                                &lanes_sse2_impl::all_finite};
 }  // namespace dynid::detail

@@ -75,17 +75,16 @@ inline long store_columns(const V* values, int n, int P, const int* columns, int
   for (int i = 0; i < n; ++i)
     for (int k = 0; k < C; ++k) {
       const V v = values[i * P + columns[k]];
-      check += v * 0.0;
+      add_check(check, v);
       for (int l = 0; l < count; ++l) p[l * stride + i * C + k] = v[l];
     }
-  for (int l = 0; l < count; ++l)
-    if (check[l] != 0.0) return t0 + l;
-  return -1;
+  return first_nonfinite(check, t0, count);
 }
 
 // Stores the full regressor of the block: per sample and row i, the structural zeros (links
-// j < i, the other joints' drive columns) by memset, the rest lane by lane, so that about half
-// of the 10n^2 + ... entries cost no scalar store. Returns the first non-finite sample, or -1.
+// j < i, the other joints' drive columns) by memset, the rest from the lanes (by groups of
+// columns for a full block, lane_vectors.hpp), so that about half of the 10n^2 + ... entries
+// cost no store from a vector. Returns the first non-finite sample, or -1.
 inline long store_regressor(const V* values, int n, int P, int rotor, int friction, double* out,
                             long t0, int count) {
   V check = {};
@@ -94,15 +93,22 @@ inline long store_regressor(const V* values, int n, int P, int rotor, int fricti
   const int drive = 10 * n;
   for (int i = 0; i < n; ++i) {
     const V* row = values + i * P;
+    double* first = base + i * P;  // row i of the block's first sample
     for (int l = 0; l < count; ++l) {
-      double* r = base + l * stride + i * P;
-      __builtin_memset(r, 0, sizeof(double) * 10 * i);
-      if (P > drive) __builtin_memset(r + drive, 0, sizeof(double) * (P - drive));
+      double* r = first + l * stride;
+      zero_fill(r, 10 * i);
+      zero_fill(r + drive, P - drive);
     }
-    for (int k = 10 * i; k < drive; ++k) {
-      const V v = row[k];
-      check += v * 0.0;
-      for (int l = 0; l < count; ++l) base[l * stride + i * P + k] = v[l];
+    if (kByGroups && count == W) {  // 10 (n - i) >= 10 >= G columns
+      by_groups(10 * i, drive, [&](int k) {
+        for (int g = 0; g < G; ++g) add_check(check, row[k + g]);
+        store_group(row + k, first + k, stride);
+      });
+    } else {
+      for (int k = 10 * i; k < drive; ++k) {
+        add_check(check, row[k]);
+        for (int l = 0; l < count; ++l) first[l * stride + k] = row[k][l];
+      }
     }
     int diagonal[3], entries = 0, column = drive;  // row i's own Ia, Fv, Fs columns
     if (rotor) diagonal[entries++] = column + i, column += n;
@@ -110,13 +116,11 @@ inline long store_regressor(const V* values, int n, int P, int rotor, int fricti
     for (int e = 0; e < entries; ++e) {
       const int k = diagonal[e];
       const V v = row[k];
-      check += v * 0.0;
-      for (int l = 0; l < count; ++l) base[l * stride + i * P + k] = v[l];
+      add_check(check, v);
+      for (int l = 0; l < count; ++l) first[l * stride + k] = v[l];
     }
   }
-  for (int l = 0; l < count; ++l)
-    if (check[l] != 0.0) return t0 + l;
-  return -1;
+  return first_nonfinite(check, t0, count);
 }
 
 long regressor(const BatchModel& bm, const double* q, const double* qd, const double* qdd,
@@ -126,21 +130,24 @@ long regressor(const BatchModel& bm, const double* q, const double* qd, const do
   Joint X[n + 1];
   V d[n + 1];     // joint offsets along z (prismatic: q + d)
   V U[n + 1][6];  // joint axes in the current link's parameter frame
-  V out[n * P];
+  V out[n * P], qv[n], qdv[n], qddv[n];
+  const V zero = {};
+  // Every block writes the same entries of `out` (blocks Y_ij, i <= j, and the drive diagonals):
+  // the structural zeros, which store_columns may read, are set once.
+  for (int k = 0; k < n * P; ++k) out[k] = zero;
   for (long t0 = 0; t0 < T; t0 += W) {
     const int count = T - t0 < W ? static_cast<int>(T - t0) : W;
-    const V zero = {};
-    for (int k = 0; k < n * P; ++k) out[k] = zero;
+    load_block(q, t0, count, n, qv);
+    load_block(qd, t0, count, n, qdv);
+    load_block(qdd, t0, count, n, qddv);
     V3 w = {zero, zero, zero}, wd = w, a = splat3(bm.base_acceleration);
     for (int j = 1; j <= n; ++j) {
       const BatchJoint& J = bm.joints[j - 1];
-      const V qj = load(q, t0, count, n, j - 1), qdj = load(qd, t0, count, n, j - 1),
-              qddj = load(qdd, t0, count, n, j - 1);
+      const V qj = qv[j - 1], qdj = qdv[j - 1], qddj = qddv[j - 1];
       set_joint(J, qj, X[j]);
       d[j] = J.revolute ? splat(J.d) : qj + J.d;
       // Forward pass (propagate_motion): link j's w, wd and origin acceleration in J_j.
-      const V3& p = X[j].p;
-      const V3 origin_acc = a + cross(wd, p) + cross(w, cross(w, p));
+      const V3 origin_acc = origin_acceleration(J, X[j], w, wd, a);
       const V3 w_in = rotate_to_child(X[j], w), wd_in = rotate_to_child(X[j], wd);
       const V3 acc = rotate_to_child(X[j], origin_acc);
       if (J.revolute) {

@@ -12,5 +12,6 @@ const LaneKernels lanes_avx2 = {"avx2",
                                 &lanes_avx2_impl::gravity,
                                 &lanes_avx2_impl::mass_matrix,
                                 &lanes_avx2_impl::regressor,
-                                &lanes_avx2_impl::sincos_many};
+                                &lanes_avx2_impl::sincos_many,
+                                &lanes_avx2_impl::all_finite};
 }  // namespace dynid::detail

@@ -12,5 +12,6 @@ const LaneKernels lanes_avx512 = {"avx512",
                                   &lanes_avx512_impl::gravity,
                                   &lanes_avx512_impl::mass_matrix,
                                   &lanes_avx512_impl::regressor,
-                                  &lanes_avx512_impl::sincos_many};
+                                  &lanes_avx512_impl::sincos_many,
+                                  &lanes_avx512_impl::all_finite};
 }  // namespace dynid::detail

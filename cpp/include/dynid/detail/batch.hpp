@@ -29,6 +29,10 @@ std::vector<std::string> supported_batch_isas();
 // path forced), or libm's when there is none; a few ulp (tests/test_batch_lanes.py).
 void sincos_many(const double* x, double* s, double* c, int count);
 
+// True when all `count` values are finite, by the widest lanes the CPU runs (a pass over large
+// inputs at the memory's speed; the scalar loop when there are none).
+bool all_finite_many(const double* x, long count);
+
 // The model as plain numbers; `joints` is the storage the result points into.
 BatchModel batch_model(const Model& model, std::vector<BatchJoint>& joints);
 

@@ -39,6 +39,8 @@ using BatchRegressor = long (*)(const BatchModel&, const double* q, const double
 
 // sin and cos of `count` angles (the lane kernels' vectorised sincos, a few ulp).
 using SinCos = void (*)(const double* x, double* s, double* c, int count);
+// True when all `count` values are finite.
+using AllFinite = bool (*)(const double* x, long count);
 
 struct LaneKernels {
   const char* name;  // "sse2", "avx2", "avx512"
@@ -48,6 +50,7 @@ struct LaneKernels {
   BatchMassMatrix mass_matrix;
   BatchRegressor regressor;
   SinCos sincos;
+  AllFinite all_finite;
 };
 
 // Defined in cpp/src/batch/lanes_*.cpp (the AVX ones on x86-64 only).
