@@ -304,6 +304,10 @@ def test_bad_input_is_named() -> None:
         dynid.models.planar_parallelogram([1, 1, -1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.4)
     with pytest.raises(ValueError, match="l2"):
         dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.0)
+    with pytest.raises(ValueError, match="l1"):
+        dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, "long", 0.4)
+    with pytest.raises(ValueError, match="gravity"):
+        dynid.models.planar_parallelogram([1, 1, 1, 1], [0.1] * 4, [0.2] * 4, 0.5, 0.4, "down")
     with pytest.raises(ValueError, match="Fv"):
         chain.Fv = [1.0, -1.0]
     with pytest.raises(ValueError, match="kind"):

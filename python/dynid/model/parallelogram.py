@@ -27,6 +27,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .. import _checks as checks
 from .closed_chain import ClosedChain
 from .loop_closures import LinearClosure
 from .robot import Robot
@@ -66,12 +67,14 @@ def planar_parallelogram(
     )
     if np.any(m <= 0) or np.any(inertia <= 0):
         raise ValueError("masses, inertias: expected positive values")
-    for value, name in ((l1, "l1"), (l2, "l2")):
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{name}: expected a positive length, got {value!r}")
-    if not np.isfinite(gravity):
-        raise ValueError(f"gravity: expected a finite g0, got {gravity!r}")
-    g = (0.0, -float(gravity), 0.0)
+    l1, l2 = checks.positive(l1, "l1"), checks.positive(l2, "l2")
+    try:
+        g0 = float(gravity)
+    except (TypeError, ValueError):
+        g0 = float("nan")
+    if not np.isfinite(g0) or isinstance(gravity, bool):
+        raise ValueError(f"gravity: expected a finite g0 [m/s^2], got {gravity!r}")
+    g = (0.0, -g0, 0.0)
 
     def branch(first_length: float, tool_x: float, name: str) -> Robot:
         tool = np.eye(4)
@@ -84,8 +87,8 @@ def planar_parallelogram(
     # Modified DH puts frame i at pivot i with x_i along link i, so each CoM is (lc_i, 0, 0) and
     # the parameters are the notes' (mx_i = m_i lc_i, Izz_i about the pivot). Link 4's frame sits
     # at A with x along -e(q2); C is at x = -l2 (branch 0's tool), and at x = l1 on link 3.
-    links_14 = branch(float(l1), -float(l2), "links 1, 4")
-    links_23 = branch(float(l2), float(l1), "links 2, 3")
+    links_14 = branch(l1, -l2, "links 1, 4")
+    links_23 = branch(l2, l1, "links 2, 3")
     placement = {1: (links_14, 0), 4: (links_14, 1), 2: (links_23, 0), 3: (links_23, 1)}
     for number, (robot, index) in placement.items():
         izz = inertia[number - 1]
