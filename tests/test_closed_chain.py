@@ -383,6 +383,8 @@ def test_identification_from_positions_only() -> None:
         dynid.identify_closed_chain(
             dynid.Log(t=full.t, q=np.zeros((len(full.t), 3)), tau=np.zeros((len(full.t), 3))), chain
         )
+    with pytest.raises(ValueError, match="cutof: not an option"):
+        dynid.identify_closed_chain(log, chain, cutof=5.0)
     with pytest.raises(ValueError, match=r"chain: expected a dynid\.ClosedChain"):
         dynid.identify_closed_chain(log, dynid.models.planar_2r())
 

@@ -10,6 +10,7 @@ records them: q, tau (and qd, qdd when it has them) of the n motors. The log goe
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from dataclasses import dataclass
 from typing import Any
 
@@ -78,6 +79,13 @@ def identify_closed_chain(
         raise ValueError(f"chain: expected a dynid.ClosedChain, got {type(chain).__name__}")
     if not isinstance(log, Log):
         raise ValueError(f"log: expected a dynid.Log, got {type(log).__name__}")
+    known = [name for name in inspect.signature(prepare_log).parameters if name != "log"]
+    unknown = [name for name in preparation if name not in known]
+    if unknown:
+        raise ValueError(
+            f"{unknown[0]}: not an option of identify_closed_chain or dynid.prepare_log "
+            f"(those are: {', '.join(known)})"
+        )
     prepared = _with_derivatives(
         prepare_log(log, **preparation) if preparation else log, chain.n, chain.name
     )
