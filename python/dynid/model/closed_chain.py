@@ -242,38 +242,37 @@ class ClosedChain:
 
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """Inertia matrix M(q) = G^T M_tree(y) G + diag(Ia) (notes p. 9), (n, n) or (T, n, n)."""
-        motion = self.tree_motion(q)
+        return self._shape(self._mass_matrix(self.tree_motion(q)), q)
+
+    def _mass_matrix(self, motion: Motion) -> NDArray[np.float64]:
         T = motion.y.shape[0]
         M_tree = np.zeros((T, self.tree_dof, self.tree_dof))
         for k, (b, y) in enumerate(zip(self.branches, self._per_branch(motion.y))):
             part = slice(self._edges[k], self._edges[k + 1])
             M_tree[:, part, part] = b.mass_matrix(y).reshape(T, b.n, b.n)
-        M = np.einsum("tmi,tmk,tkj->tij", motion.G, M_tree, motion.G) + np.diag(self.Ia)
-        return self._shape(M, q)
+        M: NDArray[np.float64] = np.einsum("tmi,tmk,tkj->tij", motion.G, M_tree, motion.G)
+        return M + np.diag(self.Ia)
 
     def coriolis(self, q: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         """Centrifugal and Coriolis torques c(q, qd) = G^T (M_tree Gdot qd + c_tree)."""
-        zero = np.zeros_like(self._batch(qd, "qd"))
-        rigid = self._rigid_rnea(q, qd, zero)
-        return self._shape(rigid - self._batch(self.gravity(q), "q"), q)
-
-    def _rigid_rnea(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
-        motion = self.tree_motion(q, qd, qdd)
-        return self._project(motion.G, self._tree_call("rnea", motion.y, motion.yd, motion.ydd))
+        qdb = self._batch(qd, "qd")
+        motion = self.tree_motion(q, qdb, np.zeros_like(qdb))
+        rigid = self._project(motion.G, self._tree_call("rnea", motion.y, motion.yd, motion.ydd))
+        gravity = self._project(motion.G, self._tree_call("gravity", motion.y))
+        return self._shape(rigid - gravity, q)
 
     def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]:
         """Accelerations qdd = M^-1 (tau - c - g - friction) of the independent joints."""
-        qb, qdb = self._batch(q, "q"), self._batch(qd, "qd", None)
+        qb = self._batch(q, "q")
+        qdb = self._batch(qd, "qd", qb.shape[0])
         taub = self._batch(tau, "tau", qb.shape[0])
-        if qdb.shape[0] != qb.shape[0]:
-            raise ValueError(f"qd: {qdb.shape[0]} samples, q has {qb.shape[0]}")
-        bias = self._rigid_rnea(qb, qdb, np.zeros_like(qdb)) + self._drive(qdb, np.zeros_like(qdb))
-        M = self._batch_matrix(self.mass_matrix(qb))
+        zero = np.zeros_like(qdb)
+        motion = self.tree_motion(qb, qdb, zero)  # one closure solve for the bias and M
+        bias = self._project(motion.G, self._tree_call("rnea", motion.y, motion.yd, motion.ydd))
+        bias += self._drive(qdb, zero)
+        M = self._mass_matrix(motion)
         qdd = np.asarray(np.linalg.solve(M, (taub - bias)[..., None])[..., 0], dtype=np.float64)
         return self._shape(qdd, q)
-
-    def _batch_matrix(self, M: NDArray[np.float64]) -> NDArray[np.float64]:
-        return M.reshape(-1, self.n, self.n)
 
     def kinetic_energy(self, q: ArrayLike, qd: ArrayLike) -> float | NDArray[np.float64]:
         """Kinetic energy: the tree's at yd = G qd, plus the rotors' 1/2 Ia qd^2."""
