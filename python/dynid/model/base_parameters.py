@@ -86,7 +86,8 @@ def base_parameters(
     (the gravity regressor has neither; the inertia regressor has no friction). A
     :class:`dynid.ClosedChain` answers with its own :meth:`~dynid.ClosedChain.base_parameters`.
     """
-    if not isinstance(robot, Robot) and type(robot).__name__ == "ClosedChain":
+    if not isinstance(robot, Robot) and hasattr(robot, "closure"):
+        # a closed chain (model/closed_chain.py imports this module: no import back)
         return robot.base_parameters(kind, rotor=rotor, friction=friction)
     checks.robot(robot)
     if not isinstance(kind, str) or kind not in KINDS:
