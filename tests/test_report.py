@@ -24,6 +24,7 @@ from dynid.export.report_figures import MAX_POINTS, envelope_with_gaps, with_gap
 from dynid.identification.log_identification import LogValidation
 from dynid.logs import Log, save_log
 from dynid.model.model_files import save_model
+from test_cli import _arm
 from test_log_identification import fourier_log
 
 NAME = 'arm <&> "2R"'  # a name that must be escaped
@@ -136,13 +137,6 @@ def runs(keep: np.ndarray) -> list[tuple[int, int]]:
 
 
 # --------------------------------------------------------------------------- the runs
-
-
-def _arm() -> dynid.Robot:
-    robot = dynid.models.planar_2r()
-    robot.Fv = np.array([0.3, 0.2])
-    robot.Fs = np.array([0.4, 0.1])
-    return robot
 
 
 @pytest.fixture(scope="module")

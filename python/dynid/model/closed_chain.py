@@ -278,8 +278,9 @@ class ClosedChain:
         """Kinetic energy: the tree's at yd = G qd, plus the rotors' 1/2 Ia qd^2."""
         motion = self.tree_motion(q, qd)
         energy = 0.5 * np.sum(self.Ia * self._batch(qd, "qd") ** 2, axis=1)
-        for k, branch in enumerate(self.branches):
-            y, yd = self._per_branch(motion.y)[k], self._per_branch(motion.yd)[k]
+        for branch, y, yd in zip(
+            self.branches, self._per_branch(motion.y), self._per_branch(motion.yd)
+        ):
             energy = energy + np.asarray(branch.kinetic_energy(y, yd)).reshape(-1)
         return float(energy[0]) if np.ndim(q) == 1 else energy
 
@@ -287,8 +288,7 @@ class ClosedChain:
         """Gravity potential energy of the tree at y(q) (notes p. 10: the y-components of p_ci)."""
         motion = self.tree_motion(q)
         energy = np.zeros(motion.y.shape[0])
-        for k, branch in enumerate(self.branches):
-            y = self._per_branch(motion.y)[k]
+        for branch, y in zip(self.branches, self._per_branch(motion.y)):
             energy = energy + np.asarray(branch.potential_energy(y)).reshape(-1)
         return float(energy[0]) if np.ndim(q) == 1 else energy
 
